@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# The full test suite, installing what it needs: lavapipe (Mesa's software Vulkan, Debian
+# package mesa-vulkan-drivers) for the GPU tests, and Gmsh from PyPI for the round-trip tests.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+sudo_if_needed() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
+
+if ! ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1; then
+  echo "== installing lavapipe (mesa-vulkan-drivers)"
+  sudo_if_needed apt-get update -qq
+  sudo_if_needed env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers
+fi
+if ! python3 -c "import gmsh" >/dev/null 2>&1; then
+  echo "== installing gmsh 4.15.2 from PyPI (tests and data only)"
+  python3 -m pip install -q gmsh==4.15.2 || echo "warning: could not install gmsh; its round-trip tests will skip"
+fi
+
+echo "== cargo fmt --check"
+cargo fmt --all -- --check
+echo "== cargo clippy"
+cargo clippy --all-targets -- -D warnings
+echo "== cargo test (release)"
+cargo test --release
+echo "== cargo doc"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
+echo "== all checks passed"

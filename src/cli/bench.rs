@@ -1,0 +1,10 @@
+//! `quadrecomb bench`.
+
+use std::process::ExitCode;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("`quadrecomb bench` is not implemented yet")
+}

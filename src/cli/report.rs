@@ -1,0 +1,10 @@
+//! `quadrecomb report`.
+
+use std::process::ExitCode;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("`quadrecomb report` is not implemented yet")
+}

@@ -1,0 +1,8 @@
+//! quadrecomb: recombine triangle meshes into quad meshes by sequential decision-making.
+//!
+//! Data flows one way: a mesh file becomes a [`mesh::Mesh`] (geometry and topology), the mesh
+//! gives a [`quality::CandidateTable`] (pairs, quad vertices, eta), the table feeds the searches,
+//! searches give run records, records give statistics, statistics give reports.
+
+pub mod mesh;
+pub mod quality;

@@ -1,0 +1,65 @@
+//! Typed errors for mesh input: what is wrong, and which element, node or line it concerns.
+//!
+//! `MeshError` says what is wrong with a mesh's *content* (geometry or topology);
+//! `ReadError` wraps it with the file (and line, where a reader knows it) it came from.
+
+use std::path::PathBuf;
+
+/// Something wrong with a mesh's content. Element and node ids are the ones of the input
+/// file (Gmsh tags), or 1-based indices for meshes that were built in memory.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    #[error("the mesh is empty: no nodes and no elements")]
+    Empty,
+    #[error("the mesh has no triangles (nothing to recombine)")]
+    NoTriangles,
+    #[error(
+        "the mesh is too large: {vertices} vertices, {triangles} triangles (at most 2^32 - 2 each)"
+    )]
+    TooLarge { vertices: usize, triangles: usize },
+    #[error("node {node} has a non-finite coordinate ({x}, {y}, {z})")]
+    NonFiniteCoordinate { node: u64, x: f64, y: f64, z: f64 },
+    #[error("element {element} refers to node {node}, which does not exist")]
+    UnknownNode { element: u64, node: u64 },
+    #[error("element {element} uses node {node} twice")]
+    RepeatedNode { element: u64, node: u64 },
+    #[error("triangle {element} is degenerate (zero area): nodes {nodes:?}")]
+    DegenerateTriangle { element: u64, nodes: [u64; 3] },
+    #[error("triangle {element} duplicates triangle {first} (same three nodes)")]
+    DuplicateTriangle { element: u64, first: u64 },
+    #[error(
+        "non-manifold edge between nodes {a} and {b}: shared by {count} elements (first ones: {elements:?})"
+    )]
+    NonManifoldEdge {
+        a: u64,
+        b: u64,
+        count: usize,
+        elements: Vec<u64>,
+    },
+    #[error(
+        "surface {surface} is not orientable: triangles cannot be oriented consistently (conflict at triangle {element})"
+    )]
+    NonOrientable { surface: i32, element: u64 },
+}
+
+/// A mesh file that could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "{path}: unknown mesh format (expected a Gmsh .msh file, version 2.2 or 4.1, ASCII or binary, or a built-in name: {builtins})"
+    )]
+    UnknownFormat { path: PathBuf, builtins: String },
+    #[error("{path}:{line}: {message}")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("{path}: {source}")]
+    Mesh { path: PathBuf, source: MeshError },
+}

@@ -1,0 +1,1 @@
+//! Procedural meshes of any size, without Gmsh: jittered right-triangle grids and icospheres.

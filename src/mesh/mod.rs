@@ -1,0 +1,116 @@
+//! The triangle mesh: geometry (vertices, triangles, input quads, surface tags) and the
+//! topology built once from it (edges, dual graph, components). Imports nothing of ours.
+
+pub mod builtin;
+mod error;
+pub mod generate;
+mod load;
+pub mod msh;
+mod topology;
+pub mod vtu;
+
+pub use load::load;
+
+pub use error::{MeshError, ReadError};
+pub use topology::Topology;
+
+/// Marker for "no triangle / no candidate" in `u32` index arrays.
+pub const NONE: u32 = u32::MAX;
+
+/// A surface mesh of triangles (and, optionally, quads given in the input, which are kept as
+/// they are and never recombined). Build it with [`Mesh::new`], which validates the input,
+/// orients every surface consistently and builds the topology.
+#[derive(Debug, Clone)]
+pub struct Mesh {
+    /// Vertex coordinates; planar meshes have z = 0.
+    pub vertices: Vec<[f64; 3]>,
+    /// Node id of each vertex in the input file (Gmsh node tag), for messages and output.
+    pub vertex_ids: Vec<u64>,
+    /// Triangles as vertex indices, oriented consistently within each surface.
+    pub triangles: Vec<[u32; 3]>,
+    /// Element id of each triangle in the input file (Gmsh element tag).
+    pub triangle_ids: Vec<u64>,
+    /// Geometric entity (surface tag) of each triangle. Only triangles of the same surface
+    /// are neighbours in the dual graph.
+    pub triangle_surface: Vec<i32>,
+    /// Quads present in the input, kept as quads.
+    pub quads: Vec<[u32; 4]>,
+    /// Surface tag of each input quad.
+    pub quad_surface: Vec<i32>,
+    /// Number of triangles whose orientation was flipped to make their surface consistent.
+    pub reoriented: usize,
+    /// Edges, dual graph, boundary and components.
+    pub topology: Topology,
+}
+
+/// The raw content of a mesh before validation, as a reader or a generator produces it.
+#[derive(Debug, Clone, Default)]
+pub struct MeshData {
+    pub vertices: Vec<[f64; 3]>,
+    /// Node tag of each vertex; empty means 1-based indices.
+    pub vertex_ids: Vec<u64>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Element tag of each triangle; empty means 1-based indices.
+    pub triangle_ids: Vec<u64>,
+    /// Surface tag of each triangle; empty means every triangle is on surface 1.
+    pub triangle_surface: Vec<i32>,
+    pub quads: Vec<[u32; 4]>,
+    /// Element tag of each quad; empty means numbered after the triangles.
+    pub quad_ids: Vec<u64>,
+    /// Surface tag of each quad; empty means surface 1.
+    pub quad_surface: Vec<i32>,
+}
+
+impl Mesh {
+    /// Validates `data` and builds the mesh: finite coordinates, node indices in range, no
+    /// repeated node in an element, no zero-area or duplicate triangle, no edge shared by more
+    /// than two elements; inconsistent orientations are fixed (and counted in `reoriented`)
+    /// where the surface is orientable, and an error otherwise.
+    pub fn new(data: MeshData) -> Result<Mesh, MeshError> {
+        topology::build(data)
+    }
+
+    /// Number of triangles.
+    pub fn num_triangles(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Coordinates of the three corners of triangle `t`.
+    pub fn triangle_points(&self, t: u32) -> [[f64; 3]; 3] {
+        self.triangles[t as usize].map(|v| self.vertices[v as usize])
+    }
+
+    /// Distinct surface tags, sorted.
+    pub fn surfaces(&self) -> Vec<i32> {
+        let mut s: Vec<i32> = self
+            .triangle_surface
+            .iter()
+            .chain(&self.quad_surface)
+            .copied()
+            .collect();
+        s.sort_unstable();
+        s.dedup();
+        s
+    }
+
+    /// Checks every invariant of the mesh and its topology; returns the first violation.
+    /// Meant for tests and debugging (`O(n log n)`).
+    pub fn sanity_check(&self) -> Result<(), String> {
+        topology::sanity_check(self)
+    }
+}
+
+/// A recombined mesh ready to be written: the quads made by merging triangle pairs (with their
+/// quality), the input quads, and the triangles left over. Built by
+/// `quality::recombined`; writers take it so that `mesh` needs nothing from later modules.
+#[derive(Debug, Clone, Default)]
+pub struct Recombined {
+    /// Quads made by recombination, vertex indices in boundary order.
+    pub quads: Vec<[u32; 4]>,
+    /// Surface tag of each recombined quad.
+    pub quad_surface: Vec<i32>,
+    /// eta of each recombined quad.
+    pub quad_eta: Vec<f64>,
+    /// Indices (into `Mesh::triangles`) of the triangles left unrecombined.
+    pub leftover: Vec<u32>,
+}

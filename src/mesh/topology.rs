@@ -1,0 +1,379 @@
+//! Topology built once from validated mesh data: unique edges, the dual graph (neighbours
+//! across each triangle side, same surface only), boundary edges and connected components.
+//! Also validation and consistent re-orientation of the input. Knows no geometry except the
+//! zero-area test.
+
+use super::{Mesh, MeshData, MeshError, NONE};
+
+/// Edges, dual graph and components of a [`Mesh`].
+///
+/// Side `i` of triangle `t` is the edge from `triangles[t][i]` to `triangles[t][(i + 1) % 3]`.
+#[derive(Debug, Clone, Default)]
+pub struct Topology {
+    /// Unique edges as sorted vertex pairs, over triangles and input quads.
+    pub edges: Vec<[u32; 2]>,
+    /// Edge index of each triangle side.
+    pub triangle_edges: Vec<[u32; 3]>,
+    /// Dual graph: the triangle across each side, or [`NONE`] on a boundary, next to a quad,
+    /// or across a surface boundary.
+    pub neighbours: Vec<[u32; 3]>,
+    /// Edges used by exactly one element (triangle or quad).
+    pub boundary_edges: Vec<u32>,
+    /// Connected component (of the dual graph) of each triangle, numbered in order of first
+    /// triangle.
+    pub component: Vec<u32>,
+    /// Number of triangles in each component.
+    pub component_sizes: Vec<u32>,
+}
+
+impl Topology {
+    /// Number of dual-graph edges (pairs of neighbouring triangles).
+    pub fn num_dual_edges(&self) -> usize {
+        self.neighbours
+            .iter()
+            .enumerate()
+            .map(|(t, n)| n.iter().filter(|&&u| u != NONE && u as usize > t).count())
+            .sum()
+    }
+}
+
+/// Validates `data` and builds the mesh with its topology.
+pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
+    let nv = data.vertices.len();
+    let nt = data.triangles.len();
+    if nv == 0 && nt == 0 && data.quads.is_empty() {
+        return Err(MeshError::Empty);
+    }
+    if nt == 0 {
+        return Err(MeshError::NoTriangles);
+    }
+    if nt >= NONE as usize || nv >= NONE as usize {
+        return Err(MeshError::TooLarge {
+            vertices: nv,
+            triangles: nt,
+        });
+    }
+    if data.vertex_ids.is_empty() {
+        data.vertex_ids = (1..=nv as u64).collect();
+    }
+    if data.triangle_ids.is_empty() {
+        data.triangle_ids = (1..=nt as u64).collect();
+    }
+    if data.triangle_surface.is_empty() {
+        data.triangle_surface = vec![1; nt];
+    }
+    if data.quad_ids.is_empty() {
+        data.quad_ids = (nt as u64 + 1..=(nt + data.quads.len()) as u64).collect();
+    }
+    if data.quad_surface.is_empty() {
+        data.quad_surface = vec![1; data.quads.len()];
+    }
+    assert_eq!(data.vertex_ids.len(), nv, "one id per vertex");
+    assert_eq!(data.triangle_ids.len(), nt, "one id per triangle");
+    assert_eq!(data.triangle_surface.len(), nt, "one surface per triangle");
+
+    for (i, p) in data.vertices.iter().enumerate() {
+        if !p.iter().all(|c| c.is_finite()) {
+            return Err(MeshError::NonFiniteCoordinate {
+                node: data.vertex_ids[i],
+                x: p[0],
+                y: p[1],
+                z: p[2],
+            });
+        }
+    }
+    let elements = data
+        .triangles
+        .iter()
+        .map(|t| &t[..])
+        .zip(&data.triangle_ids)
+        .chain(data.quads.iter().map(|q| &q[..]).zip(&data.quad_ids));
+    for (nodes, &element) in elements {
+        for (k, &v) in nodes.iter().enumerate() {
+            if v as usize >= nv {
+                // Readers map unknown tags to indices past the end; report the index as given.
+                return Err(MeshError::UnknownNode {
+                    element,
+                    node: v as u64 + 1,
+                });
+            }
+            if nodes[..k].contains(&v) {
+                return Err(MeshError::RepeatedNode {
+                    element,
+                    node: data.vertex_ids[v as usize],
+                });
+            }
+        }
+    }
+    for (t, tri) in data.triangles.iter().enumerate() {
+        let [a, b, c] = tri.map(|v| data.vertices[v as usize]);
+        let (u, w) = (sub(b, a), sub(c, a));
+        let area2 = norm(cross(u, w));
+        let scale = dot(u, u).max(dot(w, w)).max(dot(sub(c, b), sub(c, b)));
+        if area2 <= 1e-14 * scale || scale == 0.0 {
+            return Err(MeshError::DegenerateTriangle {
+                element: data.triangle_ids[t],
+                nodes: tri.map(|v| data.vertex_ids[v as usize]),
+            });
+        }
+    }
+    // Duplicate triangles: same vertex set.
+    let mut keys: Vec<([u32; 3], u32)> = data
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            let mut k = *tri;
+            k.sort_unstable();
+            (k, t as u32)
+        })
+        .collect();
+    keys.sort_unstable();
+    for w in keys.windows(2) {
+        if w[0].0 == w[1].0 {
+            return Err(MeshError::DuplicateTriangle {
+                element: data.triangle_ids[w[1].1 as usize],
+                first: data.triangle_ids[w[0].1 as usize],
+            });
+        }
+    }
+
+    // Half-edges of every element: (min, max, element, side). Quads are elements nt.. .
+    let mut half: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * nt + 4 * data.quads.len());
+    for (t, tri) in data.triangles.iter().enumerate() {
+        for i in 0..3 {
+            let (a, b) = (tri[i], tri[(i + 1) % 3]);
+            half.push((a.min(b), a.max(b), t as u32, i as u8));
+        }
+    }
+    for (q, quad) in data.quads.iter().enumerate() {
+        for i in 0..4 {
+            let (a, b) = (quad[i], quad[(i + 1) % 4]);
+            half.push((a.min(b), a.max(b), (nt + q) as u32, i as u8));
+        }
+    }
+    half.sort_unstable();
+
+    let element_id = |e: u32| -> u64 {
+        let e = e as usize;
+        if e < nt {
+            data.triangle_ids[e]
+        } else {
+            data.quad_ids[e - nt]
+        }
+    };
+    let mut edges = Vec::with_capacity(half.len() / 2 + 16);
+    let mut triangle_edges = vec![[NONE; 3]; nt];
+    let mut neighbours = vec![[NONE; 3]; nt];
+    let mut boundary_edges = Vec::new();
+    // Pairs of triangles (t, side, u, side) on the same surface sharing an edge.
+    let mut links: Vec<(u32, u8, u32, u8)> = Vec::new();
+    let mut i = 0;
+    while i < half.len() {
+        let (a, b) = (half[i].0, half[i].1);
+        let mut j = i + 1;
+        while j < half.len() && half[j].0 == a && half[j].1 == b {
+            j += 1;
+        }
+        let group = &half[i..j];
+        if group.len() > 2 {
+            return Err(MeshError::NonManifoldEdge {
+                a: data.vertex_ids[a as usize],
+                b: data.vertex_ids[b as usize],
+                count: group.len(),
+                elements: group.iter().take(4).map(|h| element_id(h.2)).collect(),
+            });
+        }
+        let e = edges.len() as u32;
+        edges.push([a, b]);
+        if group.len() == 1 {
+            boundary_edges.push(e);
+        }
+        for h in group {
+            if (h.2 as usize) < nt {
+                triangle_edges[h.2 as usize][h.3 as usize] = e;
+            }
+        }
+        if let [h0, h1] = group {
+            let (t, u) = (h0.2 as usize, h1.2 as usize);
+            if t < nt && u < nt && data.triangle_surface[t] == data.triangle_surface[u] {
+                links.push((h0.2, h0.3, h1.2, h1.3));
+            }
+        }
+        i = j;
+    }
+    for &(t, si, u, sj) in &links {
+        neighbours[t as usize][si as usize] = u;
+        neighbours[u as usize][sj as usize] = t;
+    }
+
+    // Components, and consistent orientation within each (flip[t] = reverse t).
+    let mut component = vec![NONE; nt];
+    let mut component_sizes = Vec::new();
+    let mut flip = vec![false; nt];
+    let mut stack = Vec::new();
+    for start in 0..nt {
+        if component[start] != NONE {
+            continue;
+        }
+        let c = component_sizes.len() as u32;
+        component[start] = c;
+        let mut size = 0u32;
+        stack.push(start as u32);
+        while let Some(t) = stack.pop() {
+            size += 1;
+            let tri = data.triangles[t as usize];
+            for i in 0..3 {
+                let u = neighbours[t as usize][i];
+                if u == NONE {
+                    continue;
+                }
+                // t traverses its side i as (tri[i] -> tri[i+1]); u must traverse it the other
+                // way once both flips are applied.
+                let other = data.triangles[u as usize];
+                let k = (0..3).find(|&k| other[k] == tri[i]).expect("shared vertex");
+                let same_direction = other[(k + 1) % 3] == tri[(i + 1) % 3];
+                let want = flip[t as usize] ^ same_direction;
+                if component[u as usize] == NONE {
+                    component[u as usize] = c;
+                    flip[u as usize] = want;
+                    stack.push(u);
+                } else if flip[u as usize] != want {
+                    return Err(MeshError::NonOrientable {
+                        surface: data.triangle_surface[t as usize],
+                        element: data.triangle_ids[u as usize],
+                    });
+                }
+            }
+        }
+        component_sizes.push(size);
+    }
+    // Flip the smaller side of each component so the input orientation wins where it can.
+    let mut flipped_in = vec![0u32; component_sizes.len()];
+    for t in 0..nt {
+        if flip[t] {
+            flipped_in[component[t] as usize] += 1;
+        }
+    }
+    for t in 0..nt {
+        let c = component[t] as usize;
+        if 2 * flipped_in[c] > component_sizes[c] {
+            flip[t] = !flip[t];
+        }
+    }
+    let mut reoriented = 0;
+    for t in 0..nt {
+        if flip[t] {
+            reoriented += 1;
+            // Reverse (a, b, c) -> (a, c, b): sides 0 and 2 swap, side 1 reverses in place.
+            let [a, b, c] = data.triangles[t];
+            data.triangles[t] = [a, c, b];
+            triangle_edges[t].swap(0, 2);
+            neighbours[t].swap(0, 2);
+        }
+    }
+
+    Ok(Mesh {
+        vertices: data.vertices,
+        vertex_ids: data.vertex_ids,
+        triangles: data.triangles,
+        triangle_ids: data.triangle_ids,
+        triangle_surface: data.triangle_surface,
+        quads: data.quads,
+        quad_surface: data.quad_surface,
+        reoriented,
+        topology: Topology {
+            edges,
+            triangle_edges,
+            neighbours,
+            boundary_edges,
+            component,
+            component_sizes,
+        },
+    })
+}
+
+pub(super) fn sanity_check(mesh: &Mesh) -> Result<(), String> {
+    let topo = &mesh.topology;
+    let nt = mesh.triangles.len();
+    if topo.neighbours.len() != nt || topo.triangle_edges.len() != nt || topo.component.len() != nt
+    {
+        return Err("topology arrays do not match the triangle count".into());
+    }
+    if mesh.triangle_surface.len() != nt || mesh.triangle_ids.len() != nt {
+        return Err("per-triangle arrays do not match the triangle count".into());
+    }
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for i in 0..3 {
+            let (a, b) = (tri[i], tri[(i + 1) % 3]);
+            let e = topo.triangle_edges[t][i];
+            if e as usize >= topo.edges.len() || topo.edges[e as usize] != [a.min(b), a.max(b)] {
+                return Err(format!("triangle {t} side {i}: wrong edge {e}"));
+            }
+            let u = topo.neighbours[t][i];
+            if u == NONE {
+                continue;
+            }
+            let u = u as usize;
+            if u >= nt || u == t {
+                return Err(format!("triangle {t} side {i}: bad neighbour {u}"));
+            }
+            let j = (0..3).find(|&j| topo.neighbours[u][j] == t as u32);
+            let Some(j) = j else {
+                return Err(format!("dual graph not symmetric between {t} and {u}"));
+            };
+            if topo.triangle_edges[u][j] != e {
+                return Err(format!(
+                    "triangles {t} and {u} are neighbours across different edges"
+                ));
+            }
+            let other = mesh.triangles[u];
+            if (other[j], other[(j + 1) % 3]) != (b, a) {
+                return Err(format!(
+                    "triangles {t} and {u} are not oriented consistently"
+                ));
+            }
+            if mesh.triangle_surface[t] != mesh.triangle_surface[u] {
+                return Err(format!(
+                    "triangles {t} and {u} are neighbours across surfaces"
+                ));
+            }
+            if topo.component[t] != topo.component[u] {
+                return Err(format!("neighbours {t} and {u} in different components"));
+            }
+        }
+    }
+    let mut sizes = vec![0u32; topo.component_sizes.len()];
+    for &c in &topo.component {
+        match sizes.get_mut(c as usize) {
+            Some(s) => *s += 1,
+            None => return Err(format!("component index {c} out of range")),
+        }
+    }
+    if sizes != topo.component_sizes {
+        return Err("component sizes do not match the component labels".into());
+    }
+    let mut sorted = topo.edges.clone();
+    sorted.sort_unstable();
+    if sorted.windows(2).any(|w| w[0] == w[1]) || topo.edges.iter().any(|e| e[0] >= e[1]) {
+        return Err("edges are not unique sorted pairs".into());
+    }
+    Ok(())
+}
+
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}

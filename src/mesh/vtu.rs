@@ -1,0 +1,1 @@
+//! VTK `.vtu` (XML unstructured grid) writer for ParaView, with per-cell quality.

@@ -1,0 +1,203 @@
+//! Quad shape quality eta (eq. 1 of the paper) and the candidate table: one entry per
+//! dual-graph edge, i.e. per pair of neighbouring triangles that may be merged into a quad.
+//!
+//! The candidate table is what the searches, the optimum and the GPU kernel share. Its
+//! `eta` column is filled either here in f64 ([`CandidateTable::build`]) or on a device
+//! (`gpu`), and the searches never know which.
+
+use crate::mesh::{Mesh, NONE, Recombined};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// Angle at `p` between the rays to `a` and `b`, in `[0, pi]`, robust for tiny and huge
+/// coordinates (atan2 of |cross| and dot). Degenerate rays give 0.
+pub fn angle(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let u = [a[0] - p[0], a[1] - p[1], a[2] - p[2]];
+    let v = [b[0] - p[0], b[1] - p[1], b[2] - p[2]];
+    let c = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let cn = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+    let d = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    cn.atan2(d)
+}
+
+/// eta from the four interior angles of a quad: `max(0, 1 - 2/pi * max_k |pi/2 - alpha_k|)`,
+/// and 0 when any angle is `>= pi` (non-convex) or `<= 0`.
+pub fn eta_from_angles(alpha: [f64; 4]) -> f64 {
+    let mut worst: f64 = 0.0;
+    for a in alpha {
+        if !(a > 0.0 && a < PI) {
+            return 0.0;
+        }
+        worst = worst.max((FRAC_PI_2 - a).abs());
+    }
+    (1.0 - worst / FRAC_PI_2).max(0.0)
+}
+
+/// eta of the quad `[s0, o1, s1, o0]` made of triangles `(s0, s1, o0)` and `(s1, s0, o1)`
+/// sharing the diagonal `s0`–`s1`. At the diagonal's endpoints the angle is the *sum* of the
+/// two triangles' angles there (3D angles, so surface meshes work); at the opposite vertices it
+/// is the triangle's own angle.
+pub fn quad_eta(p: [[f64; 3]; 4]) -> f64 {
+    let [s0, o1, s1, o0] = p;
+    let a0 = angle(s0, s1, o0) + angle(s0, o1, s1);
+    let a1 = angle(o1, s0, s1);
+    let a2 = angle(s1, o0, s0) + angle(s1, s0, o1);
+    let a3 = angle(o0, s1, s0);
+    eta_from_angles([a0, a1, a2, a3])
+}
+
+/// The candidate table: one entry per pair of neighbouring triangles (dual-graph edge).
+///
+/// Candidates are numbered in order of their lower triangle, then side. `quads[c]` lists the
+/// quad's vertices in order `[s0, o1, s1, o0]`: the diagonal (shared edge) is `quads[c][0]`–
+/// `quads[c][2]`, and `pairs[c] = [t0, t1]` with `t0 < t1`, `t0 = (s0, s1, o0)`.
+#[derive(Debug, Clone, Default)]
+pub struct CandidateTable {
+    /// The two triangles of each candidate, lower index first.
+    pub pairs: Vec<[u32; 2]>,
+    /// The quad's four vertices, diagonal at positions 0 and 2.
+    pub quads: Vec<[u32; 4]>,
+    /// Quality eta of each candidate quad, in `[0, 1]`.
+    pub eta: Vec<f64>,
+    /// For each triangle, the candidate across each of its sides, or [`NONE`].
+    pub by_triangle: Vec<[u32; 3]>,
+}
+
+impl CandidateTable {
+    /// The table's topology (pairs, quads, `by_triangle`) with eta left at zero, for a device
+    /// to fill.
+    pub fn topology_only(mesh: &Mesh) -> CandidateTable {
+        let nt = mesh.num_triangles();
+        let n = mesh.topology.num_dual_edges();
+        let mut table = CandidateTable {
+            pairs: Vec::with_capacity(n),
+            quads: Vec::with_capacity(n),
+            eta: vec![0.0; n],
+            by_triangle: vec![[NONE; 3]; nt],
+        };
+        for t in 0..nt {
+            for i in 0..3 {
+                let u = mesh.topology.neighbours[t][i];
+                if u == NONE || (u as usize) < t {
+                    continue;
+                }
+                let tri = mesh.triangles[t];
+                let (s0, s1, o0) = (tri[i], tri[(i + 1) % 3], tri[(i + 2) % 3]);
+                let other = mesh.triangles[u as usize];
+                let j = (0..3)
+                    .find(|&j| mesh.topology.neighbours[u as usize][j] == t as u32)
+                    .expect("symmetric dual graph");
+                let o1 = other[(j + 2) % 3];
+                let c = table.pairs.len() as u32;
+                table.pairs.push([t as u32, u]);
+                table.quads.push([s0, o1, s1, o0]);
+                table.by_triangle[t][i] = c;
+                table.by_triangle[u as usize][j] = c;
+            }
+        }
+        table
+    }
+
+    /// The full table with eta computed in f64 on the CPU (the reference).
+    pub fn build(mesh: &Mesh) -> CandidateTable {
+        let mut table = CandidateTable::topology_only(mesh);
+        table.eta = table
+            .quads
+            .iter()
+            .map(|q| quad_eta(q.map(|v| mesh.vertices[v as usize])))
+            .collect();
+        table
+    }
+
+    /// Number of candidates.
+    pub fn len(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// True when no two triangles are neighbours.
+    pub fn is_empty(&self) -> bool {
+        self.pairs.is_empty()
+    }
+
+    /// The triangle paired with `t` by candidate `c`.
+    #[inline]
+    pub fn other(&self, c: u32, t: u32) -> u32 {
+        let [a, b] = self.pairs[c as usize];
+        if a == t { b } else { a }
+    }
+}
+
+/// The recombined mesh given by the chosen candidates (a matching: no triangle twice).
+pub fn recombined(mesh: &Mesh, table: &CandidateTable, chosen: &[u32]) -> Recombined {
+    let mut used = vec![false; mesh.num_triangles()];
+    let mut out = Recombined::default();
+    for &c in chosen {
+        let [a, b] = table.pairs[c as usize];
+        debug_assert!(
+            !used[a as usize] && !used[b as usize],
+            "candidate {c} reuses a triangle"
+        );
+        used[a as usize] = true;
+        used[b as usize] = true;
+        out.quads.push(table.quads[c as usize]);
+        out.quad_surface.push(mesh.triangle_surface[a as usize]);
+        out.quad_eta.push(table.eta[c as usize]);
+    }
+    out.leftover = (0..mesh.num_triangles() as u32)
+        .filter(|&t| !used[t as usize])
+        .collect();
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_square_has_eta_one() {
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        assert!((quad_eta(p) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn rhombus_60_degrees() {
+        // Angles 60 and 120: worst deviation 30 degrees -> eta = 1 - 30/90 = 2/3.
+        let h = 3f64.sqrt() / 2.0;
+        let p = [
+            [0.0, 0.0, 0.0],
+            [0.5, -h, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.5, h, 0.0],
+        ];
+        assert!((quad_eta(p) - 2.0 / 3.0).abs() < 1e-12, "{}", quad_eta(p));
+    }
+
+    #[test]
+    fn non_convex_quad_has_eta_zero() {
+        // Dart: the diagonal endpoint s1 sees a reflex angle.
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [0.3, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        assert_eq!(quad_eta(p), 0.0);
+    }
+
+    #[test]
+    fn folded_quad_uses_intrinsic_3d_angles() {
+        // Two right isosceles triangles folded by 90 degrees along the diagonal (0,0,0)-(1,1,0):
+        // every 3D angle is still 90 degrees, so eta stays 1 (a planar projection would not).
+        let z = std::f64::consts::FRAC_1_SQRT_2;
+        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.5, 0.5, z]];
+        assert!((quad_eta(p) - 1.0).abs() < 1e-12, "{}", quad_eta(p));
+    }
+}
