@@ -4,5 +4,10 @@
 //! gives a [`quality::CandidateTable`] (pairs, quad vertices, eta), the table feeds the searches,
 //! searches give run records, records give statistics, statistics give reports.
 
+pub mod experiment;
+pub mod gpu;
 pub mod mesh;
 pub mod quality;
+pub mod report;
+pub mod search;
+pub mod stats;

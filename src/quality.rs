@@ -197,7 +197,12 @@ mod tests {
         // Two right isosceles triangles folded by 90 degrees along the diagonal (0,0,0)-(1,1,0):
         // every 3D angle is still 90 degrees, so eta stays 1 (a planar projection would not).
         let z = std::f64::consts::FRAC_1_SQRT_2;
-        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.5, 0.5, z]];
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.5, 0.5, z],
+        ];
         assert!((quad_eta(p) - 1.0).abs() < 1e-12, "{}", quad_eta(p));
     }
 }

@@ -1,4 +1,4 @@
-//! `quadrecomb bench`.
+//! `quadrecomb bench optimum`.
 
 use std::process::ExitCode;
 
@@ -6,5 +6,5 @@ use std::process::ExitCode;
 pub struct Args {}
 
 pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`quadrecomb bench` is not implemented yet")
+    anyhow::bail!("`quadrecomb bench optimum` is not implemented yet")
 }

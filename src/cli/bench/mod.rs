@@ -1,0 +1,35 @@
+//! `quadrecomb bench`: benchmark figures, one subcommand per area.
+
+mod gpu;
+mod io;
+mod optimum;
+mod search;
+
+use std::process::ExitCode;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    what: What,
+}
+
+#[derive(Debug, clap::Subcommand)]
+enum What {
+    /// Mesh parsing and topology building.
+    Io(io::Args),
+    /// Search policies (greedy, selective, uniform).
+    Search(search::Args),
+    /// Exact optimum.
+    Optimum(optimum::Args),
+    /// Quad-quality evaluation: CPU, lavapipe, GPU.
+    Gpu(gpu::Args),
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    match args.what {
+        What::Io(a) => io::run(a),
+        What::Search(a) => search::run(a),
+        What::Optimum(a) => optimum::run(a),
+        What::Gpu(a) => gpu::run(a),
+    }
+}

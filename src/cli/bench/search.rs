@@ -1,0 +1,10 @@
+//! `quadrecomb bench search`.
+
+use std::process::ExitCode;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("`quadrecomb bench search` is not implemented yet")
+}

@@ -1,0 +1,1 @@
+//! Experiments: seeded, parallel, resumable horizon sweeps and their run records.

@@ -1,0 +1,1 @@
+//! Reports: tables, box plots, mesh pictures and statistical comparisons from sweep results.

@@ -1,0 +1,1 @@
+//! Exact optimum: maximum-weight maximum-cardinality matching on the dual graph ("Blossom-quad").

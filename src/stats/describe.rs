@@ -1,0 +1,1 @@
+//! Descriptive statistics: quantiles, box-plot figures, mean and deviation, growth fits.

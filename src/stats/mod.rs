@@ -1,0 +1,4 @@
+//! Statistics: plain numbers in, numbers out.
+
+pub mod compare;
+pub mod describe;
