@@ -141,6 +141,36 @@ fn builtin_files_are_reproducible_with_gmsh() {
     }
 }
 
+/// The built-ins load by name (from any directory) into valid meshes of the expected size.
+#[test]
+fn builtin_meshes_load_by_name() {
+    for (name, triangles, vertices, euler_characteristic, boundary) in [
+        ("borouchaki", 34_456, 17_584, 0, true),
+        ("sphere", 2_104, 1_054, 2, false),
+    ] {
+        let mesh = checked(quadrecomb::mesh::load(name).expect(name));
+        assert_eq!(mesh.num_triangles(), triangles, "{name}");
+        assert_eq!(mesh.vertices.len(), vertices, "{name}");
+        assert_eq!(mesh.surfaces(), vec![1], "{name}");
+        assert_eq!(
+            mesh.topology.component_sizes,
+            vec![triangles as u32],
+            "{name}"
+        );
+        assert_eq!(euler(&mesh), euler_characteristic, "{name}");
+        assert_eq!(!mesh.topology.boundary_edges.is_empty(), boundary, "{name}");
+    }
+    // From another directory, through the CLI.
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_in(dir.path(), &["info", "borouchaki"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("34456"));
+}
+
 // ---------------------------------------------------------------- grid
 
 #[test]
@@ -647,6 +677,24 @@ fn cli_generate_grid_writes_the_library_grid() {
     a.sort_unstable();
     b.sort_unstable();
     assert_eq!(a, b);
+    // Read back by the library: same coordinates (exactly) per node, same topology.
+    let back = checked(quadrecomb::mesh::msh::read(&dir.path().join("g.msh")).unwrap());
+    let by_id = |m: &Mesh| {
+        let mut v: Vec<(u64, [f64; 3])> = m
+            .vertex_ids
+            .iter()
+            .copied()
+            .zip(m.vertices.iter().copied())
+            .collect();
+        v.sort_unstable_by_key(|p| p.0);
+        v
+    };
+    assert!(
+        by_id(&back) == by_id(&mesh),
+        "coordinates round-trip exactly"
+    );
+    assert_eq!(back.topology.component_sizes, mesh.topology.component_sizes);
+    assert_eq!(back.surfaces(), vec![1, 2]);
 
     // Gmsh opens it with the same counts.
     if !has_gmsh() {
