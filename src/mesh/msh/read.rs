@@ -1001,3 +1001,47 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
     }
     Ok(total)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integers_parse_exactly_or_not_at_all() {
+        assert_eq!(parse_u64(b"0"), Some(0));
+        assert_eq!(parse_u64(b"18446744073709551615"), Some(u64::MAX));
+        assert_eq!(parse_u64(b"18446744073709551616"), None);
+        assert_eq!(parse_u64(b"-1"), None);
+        assert_eq!(parse_u64(b"1.0"), None);
+        assert_eq!(parse_u64(b""), None);
+        assert_eq!(parse_i64(b"-9223372036854775808"), Some(i64::MIN));
+        assert_eq!(parse_i64(b"-9223372036854775809"), None);
+        assert_eq!(parse_i64(b"9223372036854775808"), None);
+        assert_eq!(parse_i64(b"+5"), Some(5));
+        assert_eq!(parse_i64(b"-"), None);
+    }
+
+    #[test]
+    fn node_map_is_dense_for_compact_tags_and_sparse_otherwise() {
+        let dense = NodeMap::new(&[3, 1, 2]).unwrap();
+        assert!(matches!(dense, NodeMap::Dense(_)));
+        assert_eq!(
+            (dense.get(1), dense.get(3), dense.get(0), dense.get(99)),
+            (Some(1), Some(0), None, None)
+        );
+        let sparse = NodeMap::new(&[u64::MAX, 5]).unwrap();
+        assert!(matches!(sparse, NodeMap::Sparse(_)));
+        assert_eq!(
+            (sparse.get(u64::MAX), sparse.get(5), sparse.get(6)),
+            (Some(0), Some(1), None)
+        );
+        assert_eq!(NodeMap::new(&[4, 7, 4]).err(), Some(4));
+        assert_eq!(NodeMap::new(&[u64::MAX, 9, u64::MAX]).err(), Some(u64::MAX));
+    }
+
+    #[test]
+    fn shown_tokens_are_short_and_printable() {
+        assert_eq!(show(b"ab\x01"), "ab\\x01");
+        assert!(show(&[b'x'; 100]).ends_with("..."));
+    }
+}
