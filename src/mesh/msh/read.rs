@@ -1,8 +1,9 @@
 //! The hand-written MSH parser: 2.2 and 4.1, ASCII and binary (native little-endian, checked
 //! with the int `1` marker). One pass over the bytes, no per-line allocation.
 //!
-//! ASCII errors carry the line ([`ReadError::Syntax`]); errors inside binary data carry the
-//! byte offset (as [`ReadError::Io`] of kind `InvalidData`, whose message names the offset).
+//! Errors in ASCII files carry the line ([`ReadError::Syntax`]); errors in binary files past
+//! their header carry the byte offset (as [`ReadError::Io`] of kind `InvalidData`, whose
+//! message names the offset).
 
 use super::{MshFile, MshVersion};
 use crate::mesh::{MeshData, ReadError};
@@ -150,8 +151,12 @@ impl<'a> Parser<'a> {
             .count()
     }
 
-    /// An error at text position `pos` (reported with its line).
+    /// An error at position `pos`: its line in an ASCII file, its byte offset in a binary one
+    /// (where binary data make line numbers meaningless).
     fn err(&self, pos: usize, message: impl Into<String>) -> ReadError {
+        if self.binary {
+            return self.err_bin(pos, message.into());
+        }
         ReadError::Syntax {
             path: self.path.to_path_buf(),
             line: self.line_of(pos),
@@ -537,21 +542,13 @@ fn check_finite(p: &Parser<'_>, at: usize, tag: u64, x: [f64; 3]) -> Res<()> {
         "node {tag} has a non-finite coordinate ({}, {}, {})",
         x[0], x[1], x[2]
     );
-    Err(if p.binary {
-        p.err_bin(at, msg)
-    } else {
-        p.err(at, msg)
-    })
+    Err(p.err(at, msg))
 }
 
 fn to_i32(p: &Parser<'_>, at: usize, v: i64, what: &str) -> Res<i32> {
     i32::try_from(v).map_err(|_| {
         let msg = format!("{what} {v} is out of range");
-        if p.binary {
-            p.err_bin(at, msg)
-        } else {
-            p.err(at, msg)
-        }
+        p.err(at, msg)
     })
 }
 
@@ -744,11 +741,7 @@ fn push_element(
     for (k, &n) in nodes.iter().enumerate() {
         idx[k] = map.get(n).ok_or_else(|| {
             let msg = format!("element {tag} refers to node {n}, which does not exist");
-            if p.binary {
-                p.err_bin(at, msg)
-            } else {
-                p.err(at, msg)
-            }
+            p.err(at, msg)
         })?;
     }
     if nodes.len() == 3 {
