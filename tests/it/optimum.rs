@@ -376,7 +376,9 @@ fn optimum_of_text_dump() {
     }
     let (opt, report) = optimum::solve_certified(&mesh, &table, true);
     let g = optimum::graph(&mesh, &table);
-    let stats = blossom::solve(&g).stats;
+    let mm = blossom::solve(&g);
+    let stats = mm.stats;
+    println!("shape {:?}", mm.shape());
     println!(
         "{path}: {} triangles, {} quads, {} left, quality {:.4}, best of 5 {:.4} s, check {:?}, {stats:?}",
         mesh.num_triangles(),

@@ -184,14 +184,26 @@ struct Solver {
     parent: Vec<u32>,
     label: Vec<u8>,
     join: Vec<i64>,
-    /// Leaves: the total dual `Y(v)` (vertex dual plus all enclosing blossom duals) as of
-    /// `join[top[v]]`. Blossoms: the blossom dual `z` as of `join[b]` (top level) or fixed.
+    /// Leaves: the total dual `Y(v)` (vertex dual plus all enclosing blossom duals) is
+    /// `dual[v] + hoff[h] + lazy(hnode[h])` with `h = hnd[v]`. Blossoms: the blossom dual `z`
+    /// as of `join[b]` (top level) or fixed (nested).
     dual: Vec<i64>,
     /// Minus nodes: the tree edge `[plus end, end in this node]`.
     tedge: Vec<[u32; 2]>,
     base: Vec<u32>,
     mate: Vec<u32>,
-    top: Vec<u32>,
+    /// Leaves: handle of the top-level node holding the leaf. A shrink hands the largest
+    /// child's handle to the new blossom and an expansion hands it back to the largest child,
+    /// so only the leaves of the smaller parts are touched (small-to-large).
+    hnd: Vec<u32>,
+    /// Per handle: its top-level node and the dual change it has accumulated.
+    hnode: Vec<u32>,
+    hoff: Vec<i64>,
+    free_handles: Vec<u32>,
+    /// Per node: its handle while top level, else [`NONE`].
+    node_h: Vec<u32>,
+    /// Per node: number of leaves.
+    size: Vec<u32>,
     comp: Vec<u32>,
     // Per extra node (id - n): blossom cycle, base child first; `cedges[i]` joins child `i`
     // (first end) to child `i + 1` (second end). Empty for dummies and freed ids.
@@ -205,8 +217,11 @@ struct Solver {
     // Tree state.
     delta: i64,
     heap: BinaryHeap<Reverse<(i64, u32, u32)>>,
-    tree_leaves: Vec<u32>,
-    tree_nodes: Vec<u32>,
+    /// Nodes labelled in each tree (with stale entries; `tree_of` says which are current).
+    trees: Vec<Vec<u32>>,
+    tree_alive: Vec<bool>,
+    alive: usize,
+    tree_of: Vec<u32>,
     mark: Vec<u32>,
     stamp: u32,
     scratch: Vec<u32>,
@@ -228,16 +243,21 @@ impl Solver {
             tedge: vec![[NONE; 2]; n],
             base: (0..n as u32).collect(),
             mate: vec![NONE; n],
-            top: (0..n as u32).collect(),
+            hnd: (0..n as u32).collect(),
+            hnode: (0..n as u32).collect(),
+            hoff: vec![0; n],
+            node_h: (0..n as u32).collect(),
+            size: vec![1; n],
             comp: vec![NONE; n],
             mark: vec![0; n],
+            tree_of: vec![NONE; n],
             ..Solver::default()
         }
     }
 
     #[inline]
     fn cost_k(&self, g: &Graph, k: usize) -> i64 {
-        2 * (self.wmax - g.weight[k])
+        4 * (self.wmax - g.weight[k])
     }
 
     /// Cost of edge `v`–`w` (0 for a dummy edge).
@@ -259,15 +279,55 @@ impl Solver {
         x as usize >= self.n && self.children[x as usize - self.n].is_empty()
     }
 
+    /// The top-level node holding leaf `v`.
+    #[inline]
+    fn top(&self, v: u32) -> u32 {
+        self.hnode[self.hnd[v as usize] as usize]
+    }
+
+    /// Dual change of top-level node `x` since it joined its tree.
+    #[inline]
+    fn lazy(&self, x: u32) -> i64 {
+        let x = x as usize;
+        match self.label[x] {
+            PLUS => self.delta - self.join[x],
+            MINUS => self.join[x] - self.delta,
+            _ => 0,
+        }
+    }
+
     /// Current total dual of leaf `v`.
     #[inline]
     fn yact(&self, v: u32) -> i64 {
-        let t = self.top[v as usize] as usize;
-        match self.label[t] {
-            PLUS => self.dual[v as usize] + (self.delta - self.join[t]),
-            MINUS => self.dual[v as usize] - (self.delta - self.join[t]),
-            _ => self.dual[v as usize],
+        let h = self.hnd[v as usize] as usize;
+        self.dual[v as usize] + self.hoff[h] + self.lazy(self.hnode[h])
+    }
+
+    /// Folds the pending dual change of top-level node `x` into its handle (and its blossom
+    /// dual) and restarts its clock, so that its label may change.
+    fn freeze(&mut self, x: u32) {
+        let l = self.lazy(x);
+        if l != 0 {
+            self.hoff[self.node_h[x as usize] as usize] += l;
+            if self.is_blossom(x) {
+                self.dual[x as usize] += l;
+            }
         }
+        self.join[x as usize] = self.delta;
+    }
+
+    fn new_handle(&mut self, x: u32) -> u32 {
+        let h = if let Some(h) = self.free_handles.pop() {
+            self.hnode[h as usize] = x;
+            self.hoff[h as usize] = 0;
+            h
+        } else {
+            self.hnode.push(x);
+            self.hoff.push(0);
+            (self.hnode.len() - 1) as u32
+        };
+        self.node_h[x as usize] = h;
+        h
     }
 
     /// Current dual of top-level blossom `b`.
@@ -289,7 +349,8 @@ impl Solver {
             self.dual[i] = 0;
             self.base[i] = id;
             self.mate[i] = NONE;
-            self.top[i] = id;
+            self.node_h[i] = NONE;
+            self.size[i] = 1;
             self.comp[i] = NONE;
             return id;
         }
@@ -301,9 +362,12 @@ impl Solver {
         self.tedge.push([NONE; 2]);
         self.base.push(id);
         self.mate.push(NONE);
-        self.top.push(id);
+        self.hnd.push(NONE);
+        self.node_h.push(NONE);
+        self.size.push(1);
         self.comp.push(NONE);
         self.mark.push(0);
+        self.tree_of.push(NONE);
         self.children.push(Vec::new());
         self.cedges.push(Vec::new());
         id
@@ -338,12 +402,16 @@ impl Solver {
         self.stats.free_after_greedy = (0..self.n)
             .filter(|&v| self.mate[v] == NONE && self.comp_size(self.comp[v]) > 1)
             .count();
-        for r in 0..self.n as u32 {
-            if self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1 {
-                self.grow_tree(g, r);
+        self.grow_forest(g);
+        self.heap = BinaryHeap::new();
+        // Every node is free again: fold the handles' offsets into the leaves.
+        for v in 0..self.parent.len() {
+            let h = self.hnd[v];
+            if h != NONE && (v < self.n || self.is_dummy(v as u32)) {
+                self.dual[v] += self.hoff[h as usize];
             }
         }
-        self.heap = BinaryHeap::new();
+        self.hoff.iter_mut().for_each(|o| *o = 0);
     }
 
     fn comp_size(&self, c: u32) -> u32 {
@@ -419,6 +487,8 @@ impl Solver {
     fn add_dummy(&mut self, c: u32) -> u32 {
         let d = self.new_node();
         self.comp[d as usize] = c;
+        let h = self.new_handle(d);
+        self.hnd[d as usize] = h;
         let range = self.comp_start[c as usize] as usize..self.comp_start[c as usize + 1] as usize;
         let y = self.comp_verts[range]
             .iter()
@@ -452,8 +522,8 @@ impl Solver {
     /// Event key for edge `v` (plus leaf) – `w`, or `None` when no event is needed.
     #[inline]
     fn edge_key(&self, v: u32, yv: i64, w: u32, c: i64) -> Option<i64> {
-        let tw = self.top[w as usize];
-        if tw == self.top[v as usize] {
+        let tw = self.top(w);
+        if tw == self.top(v) {
             return None;
         }
         let lw = self.label[tw as usize];
@@ -486,7 +556,7 @@ impl Solver {
     fn rescan_into(&mut self, g: &Graph, w: u32) {
         let mut heap = std::mem::take(&mut self.heap);
         self.for_neighbours(g, w, |s, v, c| {
-            if s.label[s.top[v as usize] as usize] == PLUS
+            if s.label[s.top(v) as usize] == PLUS
                 && let Some(key) = s.edge_key(v, s.yact(v), w, c)
             {
                 heap.push(Reverse((key, v, w)));
@@ -495,79 +565,73 @@ impl Solver {
         self.heap = heap;
     }
 
-    fn set_label(&mut self, x: u32, label: u8) {
+    fn set_label(&mut self, x: u32, label: u8, tree: u32) {
+        self.freeze(x);
         self.label[x as usize] = label;
-        self.join[x as usize] = self.delta;
-        self.tree_nodes.push(x);
+        self.tree_of[x as usize] = tree;
+        self.trees[tree as usize].push(x);
     }
 
-    /// Labels `x` plus and scans its leaves.
-    fn make_plus(&mut self, g: &Graph, x: u32) {
-        self.set_label(x, PLUS);
+    /// Labels `x` plus in `tree` and scans its leaves.
+    fn make_plus(&mut self, g: &Graph, x: u32, tree: u32) {
+        self.set_label(x, PLUS, tree);
         let mut leaves = std::mem::take(&mut self.scratch);
         leaves.clear();
         self.leaves_into(x, &mut leaves);
-        self.tree_leaves.extend_from_slice(&leaves);
         for &v in &leaves {
             self.scan(g, v);
         }
         self.scratch = leaves;
     }
 
-    fn make_minus(&mut self, x: u32, edge: [u32; 2], add_leaves: bool) {
-        self.set_label(x, MINUS);
+    fn make_minus(&mut self, x: u32, edge: [u32; 2], tree: u32) {
+        self.set_label(x, MINUS, tree);
         self.tedge[x as usize] = edge;
-        if add_leaves {
-            let mut leaves = std::mem::take(&mut self.scratch);
-            leaves.clear();
-            self.leaves_into(x, &mut leaves);
-            self.tree_leaves.extend_from_slice(&leaves);
-            self.scratch = leaves;
-        }
         if self.is_blossom(x) {
             let key = self.delta + self.dual[x as usize];
             self.heap.push(Reverse((key, x, NONE)));
         }
     }
 
-    fn grow_tree(&mut self, g: &Graph, r: u32) {
-        self.stats.trees += 1;
+    /// Grows alternating trees from every free vertex at once, with one dual step `delta`
+    /// for all: plus nodes rise, minus nodes fall. Two trees that meet augment and dissolve;
+    /// the others go on.
+    fn grow_forest(&mut self, g: &Graph) {
         self.delta = 0;
         self.heap.clear();
-        let root = self.top[r as usize];
-        debug_assert_eq!(self.base[root as usize], r);
-        self.make_plus(g, root);
-        loop {
+        let roots: Vec<u32> = (0..self.n as u32)
+            .filter(|&r| self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1)
+            .collect();
+        for &r in &roots {
+            let t = self.trees.len() as u32;
+            self.trees.push(Vec::new());
+            self.tree_alive.push(true);
+            self.alive += 1;
+            self.stats.trees += 1;
+            let root = self.top(r);
+            debug_assert_eq!(self.base[root as usize], r);
+            self.make_plus(g, root, t);
+        }
+        while self.alive > 0 {
             let Some(Reverse((key, a, b))) = self.heap.pop() else {
-                // Hungarian tree: no perfect matching with the dummies so far.
-                let d = self.add_dummy(self.comp[r as usize]);
-                let plus: Vec<u32> = self
-                    .tree_leaves
-                    .iter()
-                    .copied()
-                    .filter(|&v| self.label[self.top[v as usize] as usize] == PLUS)
-                    .collect();
-                for v in plus {
-                    if let Some(key) = self.edge_key(v, self.yact(v), d, 0) {
-                        self.heap.push(Reverse((key, v, d)));
-                    }
-                }
+                self.add_dummies(g);
                 continue;
             };
             self.stats.events += 1;
             debug_assert!(key >= self.delta);
             self.delta = key;
             if b == NONE {
-                if self.parent[a as usize] == NONE && self.label[a as usize] == MINUS {
-                    debug_assert_eq!(self.zact(a), 0);
+                if self.parent[a as usize] == NONE
+                    && self.label[a as usize] == MINUS
+                    && self.zact(a) == 0
+                {
                     self.expand(g, a);
                 }
                 continue;
             }
             let (v, w) = (a, b);
-            let (tv, tw) = (self.top[v as usize], self.top[w as usize]);
-            debug_assert_eq!(self.label[tv as usize], PLUS);
-            if tv == tw {
+            let (tv, tw) = (self.top(v), self.top(w));
+            if tv == tw || self.label[tv as usize] != PLUS {
                 continue;
             }
             let lw = self.label[tw as usize];
@@ -577,54 +641,99 @@ impl Solver {
             let s = self.cost(g, v, w) - self.yact(v) - self.yact(w);
             debug_assert!(s >= 0);
             if s > 0 {
+                debug_assert!(lw != PLUS || s % 2 == 0, "odd slack between plus nodes");
                 let key = self.delta + if lw == PLUS { s / 2 } else { s };
                 self.heap.push(Reverse((key, v, w)));
                 continue;
             }
+            let t = self.tree_of[tv as usize];
             if lw == PLUS {
-                self.shrink(g, v, w);
+                let u = self.tree_of[tw as usize];
+                if u == t {
+                    self.shrink(g, v, w);
+                } else {
+                    self.augment(v, w);
+                    self.augment(w, v);
+                    self.dissolve(g, t);
+                    self.dissolve(g, u);
+                }
             } else if self.mate[self.base[tw as usize] as usize] == NONE {
+                // A free node with an unmatched base: a dummy.
+                if self.is_blossom(tw) {
+                    self.rotate(tw, w);
+                }
+                self.mate[w as usize] = v;
                 self.augment(v, w);
-                break;
+                self.dissolve(g, t);
             } else {
-                self.make_minus(tw, [v, w], true);
-                let x = self.top[self.mate[self.base[tw as usize] as usize] as usize];
-                self.make_plus(g, x);
+                self.make_minus(tw, [v, w], t);
+                let x = self.top(self.mate[self.base[tw as usize] as usize]);
+                self.make_plus(g, x, t);
             }
         }
-        self.end_tree();
     }
 
-    /// Materializes the duals of the tree and clears its labels.
-    fn end_tree(&mut self) {
-        let leaves = std::mem::take(&mut self.tree_leaves);
-        let vals: Vec<i64> = leaves.iter().map(|&v| self.yact(v)).collect();
-        let nodes = std::mem::take(&mut self.tree_nodes);
-        let zs: Vec<i64> = nodes
-            .iter()
-            .map(|&x| {
-                if self.parent[x as usize] == NONE && self.is_blossom(x) {
-                    self.zact(x)
-                } else {
-                    self.dual[x as usize]
-                }
-            })
+    /// Every tree is stuck (no event left): each is a Hungarian tree, so its component needs
+    /// one more unmatched vertex; add a dummy per tree and the events into it.
+    fn add_dummies(&mut self, g: &Graph) {
+        let alive: Vec<u32> = (0..self.trees.len() as u32)
+            .filter(|&t| self.tree_alive[t as usize])
             .collect();
-        for (&v, &y) in leaves.iter().zip(&vals) {
-            self.dual[v as usize] = y;
+        for &t in &alive {
+            let root = self.trees[t as usize][0];
+            let c = self.comp[self.base[root as usize] as usize];
+            self.add_dummy(c);
         }
-        for (&x, &z) in nodes.iter().zip(&zs) {
-            if self.is_blossom(x) {
-                self.dual[x as usize] = z;
+        let _ = g;
+        let mut leaves = Vec::new();
+        for &t in &alive {
+            for &x in &self.trees[t as usize] {
+                if self.parent[x as usize] == NONE
+                    && self.label[x as usize] == PLUS
+                    && self.tree_of[x as usize] == t
+                {
+                    self.leaves_into(x, &mut leaves);
+                }
             }
         }
-        for &x in &nodes {
-            self.label[x as usize] = FREE;
+        leaves.sort_unstable();
+        leaves.dedup();
+        for v in leaves {
+            let c = self.comp[v as usize] as usize;
+            for i in 0..self.comp_dummies[c].len() {
+                let d = self.comp_dummies[c][i];
+                if self.mate[d as usize] == NONE
+                    && let Some(key) = self.edge_key(v, self.yact(v), d, 0)
+                {
+                    self.heap.push(Reverse((key, v, d)));
+                }
+            }
         }
-        self.tree_leaves = leaves;
-        self.tree_leaves.clear();
-        self.tree_nodes = nodes;
-        self.tree_nodes.clear();
+    }
+
+    /// Ends tree `t` after its augmentation: materializes its duals, frees its nodes and adds
+    /// the events from the remaining trees into them.
+    fn dissolve(&mut self, g: &Graph, t: u32) {
+        self.tree_alive[t as usize] = false;
+        self.alive -= 1;
+        let nodes = std::mem::take(&mut self.trees[t as usize]);
+        let mut leaves = std::mem::take(&mut self.scratch2);
+        leaves.clear();
+        for &x in &nodes {
+            if self.parent[x as usize] != NONE
+                || self.label[x as usize] == FREE
+                || self.tree_of[x as usize] != t
+            {
+                continue;
+            }
+            self.freeze(x);
+            self.label[x as usize] = FREE;
+            self.leaves_into(x, &mut leaves);
+        }
+        for &v in &leaves {
+            self.rescan_into(g, v);
+        }
+        self.scratch2 = leaves;
     }
 
     /// The plus node above plus node `x` in the tree, with the minus node between.
@@ -633,8 +742,8 @@ impl Solver {
         if m == NONE {
             return None;
         }
-        let mn = self.top[m as usize];
-        let p = self.top[self.tedge[mn as usize][0] as usize];
+        let mn = self.top(m);
+        let p = self.top(self.tedge[mn as usize][0]);
         Some((mn, p))
     }
 
@@ -652,7 +761,7 @@ impl Solver {
     /// Shrinks the blossom closed by the tight edge `u`–`v` between two plus nodes.
     fn shrink(&mut self, g: &Graph, u: u32, v: u32) {
         self.stats.shrinks += 1;
-        let (bu, bv) = (self.top[u as usize], self.top[v as usize]);
+        let (bu, bv) = (self.top(u), self.top(v));
         self.stamp = self.stamp.wrapping_add(1).max(1);
         let st = self.stamp;
         self.mark[bu as usize] = st;
@@ -695,32 +804,49 @@ impl Solver {
         debug_assert_eq!(ch.len(), k);
         debug_assert!(k % 2 == 1);
 
+        // Fold every child's pending change; the largest child hands its handle to `b`.
+        for &c in &ch {
+            self.freeze(c);
+        }
+        let big = *ch
+            .iter()
+            .max_by_key(|&&c| self.size[c as usize])
+            .expect("children");
+        let hb = self.node_h[big as usize];
         let b = self.new_node();
-        let lbase = self.base[lca as usize];
-        self.base[b as usize] = lbase;
+        self.base[b as usize] = self.base[lca as usize];
         self.parent[b as usize] = NONE;
         self.dual[b as usize] = 0;
-        self.set_label(b, PLUS);
+        self.node_h[b as usize] = hb;
+        self.hnode[hb as usize] = b;
+        self.node_h[big as usize] = NONE;
+        self.size[b as usize] = ch.iter().map(|&c| self.size[c as usize]).sum();
+        let tree = self.tree_of[lca as usize];
+        self.set_label(b, PLUS, tree);
         let mut leaves = std::mem::take(&mut self.scratch);
         let mut new_plus = std::mem::take(&mut self.scratch2);
         new_plus.clear();
         for &c in &ch {
-            leaves.clear();
-            self.leaves_into(c, &mut leaves);
-            for &w in &leaves {
-                self.dual[w as usize] = self.yact(w);
-            }
-            if self.is_blossom(c) {
-                self.dual[c as usize] = self.zact(c);
-            }
-            if self.label[c as usize] == MINUS {
-                new_plus.extend_from_slice(&leaves);
+            let was_minus = self.label[c as usize] == MINUS;
+            if c != big {
+                let hc = self.node_h[c as usize];
+                let diff = self.hoff[hc as usize] - self.hoff[hb as usize];
+                leaves.clear();
+                self.leaves_into(c, &mut leaves);
+                for &w in &leaves {
+                    self.dual[w as usize] += diff;
+                    self.hnd[w as usize] = hb;
+                }
+                self.free_handles.push(hc);
+                self.node_h[c as usize] = NONE;
+                if was_minus {
+                    new_plus.extend_from_slice(&leaves);
+                }
+            } else if was_minus {
+                self.leaves_into(c, &mut new_plus);
             }
             self.label[c as usize] = FREE;
             self.parent[c as usize] = b;
-            for &w in &leaves {
-                self.top[w as usize] = b;
-            }
         }
         self.children[b as usize - self.n] = ch;
         self.cedges[b as usize - self.n] = ed;
@@ -734,24 +860,36 @@ impl Solver {
     /// Expands the minus blossom `b`, whose dual is zero.
     fn expand(&mut self, g: &Graph, b: u32) {
         self.stats.expands += 1;
-        let mut leaves = std::mem::take(&mut self.scratch);
-        leaves.clear();
-        self.leaves_into(b, &mut leaves);
-        for &w in &leaves {
-            self.dual[w as usize] = self.yact(w);
-        }
+        self.freeze(b);
+        debug_assert_eq!(self.dual[b as usize], 0);
+        let hb = self.node_h[b as usize];
         let [p, x] = self.tedge[b as usize];
+        let tree = self.tree_of[b as usize];
         let ch = std::mem::take(&mut self.children[b as usize - self.n]);
         let ed = std::mem::take(&mut self.cedges[b as usize - self.n]);
         self.label[b as usize] = FREE;
+        self.node_h[b as usize] = NONE;
         self.free_ids.push(b);
+        let big = *ch
+            .iter()
+            .max_by_key(|&&c| self.size[c as usize])
+            .expect("children");
+        let mut leaves = std::mem::take(&mut self.scratch);
         for &c in &ch {
             self.parent[c as usize] = NONE;
             self.label[c as usize] = FREE;
-            leaves.clear();
-            self.leaves_into(c, &mut leaves);
-            for &w in &leaves {
-                self.top[w as usize] = c;
+            if c == big {
+                self.node_h[c as usize] = hb;
+                self.hnode[hb as usize] = c;
+            } else {
+                let hc = self.new_handle(c);
+                let off = self.hoff[hb as usize];
+                leaves.clear();
+                self.leaves_into(c, &mut leaves);
+                for &w in &leaves {
+                    self.dual[w as usize] += off;
+                    self.hnd[w as usize] = hc;
+                }
             }
         }
         let k = ch.len();
@@ -777,9 +915,9 @@ impl Solver {
         on_path.clear();
         for (s, &(c, e)) in path.iter().enumerate() {
             if s % 2 == 0 {
-                self.make_minus(c, e, false);
+                self.make_minus(c, e, tree);
             } else {
-                self.set_label(c, PLUS);
+                self.set_label(c, PLUS, tree);
             }
             on_path.push(c);
         }
@@ -805,17 +943,11 @@ impl Solver {
         self.scratch2 = on_path;
     }
 
-    /// Augments along the tree path from plus leaf `v` to the root and across the tight edge
-    /// `v`–`w` into the free node of `w`, whose base is unmatched.
+    /// Augments along the tree path from plus leaf `v` to its root, matching `v` to `w`.
     fn augment(&mut self, v: u32, w: u32) {
-        let tw = self.top[w as usize];
-        if self.is_blossom(tw) {
-            self.rotate(tw, w);
-        }
-        self.mate[w as usize] = v;
         let (mut s, mut t) = (v, w);
         loop {
-            let ts = self.top[s as usize];
+            let ts = self.top(s);
             let old = self.mate[self.base[ts as usize] as usize];
             if self.is_blossom(ts) {
                 self.rotate(ts, s);
@@ -824,7 +956,7 @@ impl Solver {
             if old == NONE {
                 break;
             }
-            let m = self.top[old as usize];
+            let m = self.top(old);
             let [p, x] = self.tedge[m as usize];
             if self.is_blossom(m) {
                 self.rotate(m, x);
@@ -1041,5 +1173,35 @@ impl Solver {
             }
         }
         (a != NONE).then_some(a)
+    }
+}
+
+impl Matching {
+    /// Temporary: (max nesting depth, max blossom size, sum of top-level blossom sizes).
+    pub fn shape(&self) -> (usize, usize, usize) {
+        let s = &self.s;
+        let mut maxd = 0;
+        for v in 0..s.n {
+            let mut d = 0;
+            let mut x = s.parent[v];
+            while x != NONE {
+                d += 1;
+                x = s.parent[x as usize];
+            }
+            maxd = maxd.max(d);
+        }
+        let mut maxs = 0;
+        let mut tot = 0;
+        for b in s.n..s.parent.len() {
+            if s.is_blossom(b as u32) {
+                let mut l = Vec::new();
+                s.leaves_into(b as u32, &mut l);
+                maxs = maxs.max(l.len());
+                if s.parent[b] == NONE {
+                    tot += l.len();
+                }
+            }
+        }
+        (maxd, maxs, tot)
     }
 }
