@@ -106,6 +106,10 @@ pub struct Stats {
     pub dummies: usize,
     /// Heap events popped.
     pub events: usize,
+    /// Leaves scanned (edges out of plus leaves pushed as events).
+    pub scans: usize,
+    /// Leaves rescanned (after leaving a tree).
+    pub rescans: usize,
 }
 
 /// A solved matching with its dual certificate.
@@ -542,6 +546,7 @@ impl Solver {
 
     /// Pushes events for every edge out of plus leaf `v`.
     fn scan(&mut self, g: &Graph, v: u32) {
+        self.stats.scans += 1;
         let yv = self.yact(v);
         let mut heap = std::mem::take(&mut self.heap);
         self.for_neighbours(g, v, |s, w, c| {
@@ -554,6 +559,7 @@ impl Solver {
 
     /// Pushes events for every edge from a plus leaf into leaf `w` (which just left the tree).
     fn rescan_into(&mut self, g: &Graph, w: u32) {
+        self.stats.rescans += 1;
         let mut heap = std::mem::take(&mut self.heap);
         self.for_neighbours(g, w, |s, v, c| {
             if s.label[s.top(v) as usize] == PLUS
@@ -629,10 +635,18 @@ impl Solver {
                 }
                 continue;
             }
-            let (v, w) = (a, b);
-            let (tv, tw) = (self.top(v), self.top(w));
-            if tv == tw || self.label[tv as usize] != PLUS {
+            // Events are kept from either end: a plus end that left the tree hands over.
+            let (mut v, mut w) = (a, b);
+            let (mut tv, mut tw) = (self.top(v), self.top(w));
+            if tv == tw {
                 continue;
+            }
+            if self.label[tv as usize] != PLUS {
+                if self.label[tw as usize] != PLUS {
+                    continue;
+                }
+                std::mem::swap(&mut v, &mut w);
+                std::mem::swap(&mut tv, &mut tw);
             }
             let lw = self.label[tw as usize];
             if lw == MINUS {
@@ -711,8 +725,8 @@ impl Solver {
         }
     }
 
-    /// Ends tree `t` after its augmentation: materializes its duals, frees its nodes and adds
-    /// the events from the remaining trees into them.
+    /// Ends tree `t` after its augmentation: folds its duals, frees its nodes and adds the
+    /// events from the remaining trees into its former minus nodes.
     fn dissolve(&mut self, g: &Graph, t: u32) {
         self.tree_alive[t as usize] = false;
         self.alive -= 1;
@@ -726,9 +740,14 @@ impl Solver {
             {
                 continue;
             }
+            // Edges from other trees into former plus leaves already have (early) events;
+            // edges into former minus leaves had none.
+            let was_minus = self.label[x as usize] == MINUS;
             self.freeze(x);
             self.label[x as usize] = FREE;
-            self.leaves_into(x, &mut leaves);
+            if was_minus {
+                self.leaves_into(x, &mut leaves);
+            }
         }
         for &v in &leaves {
             self.rescan_into(g, v);
