@@ -2,4 +2,5 @@
 
 mod io;
 mod meshes;
+mod optimum;
 mod util;
