@@ -20,6 +20,7 @@ pub mod synthetic;
 
 pub use device::{
     Kernel, Timings, adapter_name, adapters, copy_bandwidth, evaluate, is_software, open_device,
+    stream_bandwidth,
 };
 pub use layout::Batch;
 
