@@ -31,10 +31,22 @@ struct Params {
     pad: u32,
 }
 
+/// Mirrors `gpu::layout::LocalQuad`: one candidate's five edge vectors, computed on the
+/// host from f64 and each scaled to a largest component of 1, packed into four vec4:
+/// [a.xyz e0.x] [e0.yz e1.xy] [e1.z f0.xyz] [f1.xyz -], with a = s1 - s0, e0 = o0 - s0,
+/// e1 = o1 - s0, f0 = o0 - s1, f1 = o1 - s1.
+struct LocalQuad {
+    p: vec4<f32>,
+    q: vec4<f32>,
+    r: vec4<f32>,
+    s: vec4<f32>,
+}
+
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> vertices: array<Vertex>;
 @group(0) @binding(2) var<storage, read> quads: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read_write> eta: array<f32>;
+@group(0) @binding(4) var<storage, read> locals: array<LocalQuad>;
 
 const PI: f32 = 3.14159265358979;
 const FRAC_PI_2: f32 = 1.57079632679490;
@@ -79,11 +91,12 @@ fn angle(u: vec3<f32>, v: vec3<f32>) -> f32 {
 
 /// eta of the quad [s0, o1, s1, o0].
 fn quad_eta(s0: Vertex, o1: Vertex, s1: Vertex, o0: Vertex) -> f32 {
-    let a = edge(s0, s1);
-    let e0 = edge(s0, o0);
-    let e1 = edge(s0, o1);
-    let f0 = edge(s1, o0);
-    let f1 = edge(s1, o1);
+    return eta_from_edges(edge(s0, s1), edge(s0, o0), edge(s0, o1), edge(s1, o0), edge(s1, o1));
+}
+
+/// eta from the edge vectors a = s1 - s0, e0 = o0 - s0, e1 = o1 - s0, f0 = o0 - s1,
+/// f1 = o1 - s1 (each at any positive scale).
+fn eta_from_edges(a: vec3<f32>, e0: vec3<f32>, e1: vec3<f32>, f0: vec3<f32>, f1: vec3<f32>) -> f32 {
     let alpha = vec4<f32>(
         angle(a, e0) + angle(e1, a),
         angle(e1, f1),
@@ -115,4 +128,27 @@ fn quad_quality(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     eta[i] = quad_eta(s0, o1, s1, o0);
+}
+
+/// The same function on the precomputed-edges layout: streams 64 bytes per candidate, no
+/// gather. CPU twin: `gpu::cpu::quad_quality_local`.
+@compute @workgroup_size(256)
+fn quad_quality_local(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.y * params.row + gid.x;
+    if i >= params.count {
+        return;
+    }
+    let l = locals[i];
+    if MODE == 1u {
+        let m = l.p + l.q + l.r + l.s;
+        eta[i] = m.x + m.y + m.z + m.w;
+        return;
+    }
+    eta[i] = eta_from_edges(
+        l.p.xyz,
+        vec3<f32>(l.p.w, l.q.x, l.q.y),
+        vec3<f32>(l.q.z, l.q.w, l.r.x),
+        l.r.yzw,
+        l.s.xyz,
+    );
 }

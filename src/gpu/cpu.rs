@@ -3,7 +3,7 @@
 //! adapter exists. Parallel over candidates with rayon (run it inside a one-thread pool for
 //! a serial figure).
 
-use super::layout::{Batch, Vertex};
+use super::layout::{Batch, LocalQuad, Vertex};
 use rayon::prelude::*;
 
 const PI: f32 = std::f32::consts::PI;
@@ -71,11 +71,17 @@ fn neg(u: V3) -> V3 {
 
 /// The four interior angles of the quad `[s0, o1, s1, o0]` as the kernel computes them.
 pub fn quad_angles(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> [f32; 4] {
-    let a = edge(s0, s1);
-    let e0 = edge(s0, o0);
-    let e1 = edge(s0, o1);
-    let f0 = edge(s1, o0);
-    let f1 = edge(s1, o1);
+    angles_from_edges([
+        edge(s0, s1),
+        edge(s0, o0),
+        edge(s0, o1),
+        edge(s1, o0),
+        edge(s1, o1),
+    ])
+}
+
+/// The kernel's `eta_from_edges` angles from `[a, e0, e1, f0, f1]`.
+fn angles_from_edges([a, e0, e1, f0, f1]: [V3; 5]) -> [f32; 4] {
     [
         angle(a, e0) + angle(e1, a),
         angle(e1, f1),
@@ -86,7 +92,10 @@ pub fn quad_angles(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> [f32; 
 
 /// eta of the quad `[s0, o1, s1, o0]`, as the kernel's `quad_eta`.
 pub fn quad_eta(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> f32 {
-    let alpha = quad_angles(s0, o1, s1, o0);
+    eta_from_angles(quad_angles(s0, o1, s1, o0))
+}
+
+fn eta_from_angles(alpha: [f32; 4]) -> f32 {
     if alpha.iter().any(|&a| a <= 0.0 || a >= PI) {
         return 0.0;
     }
@@ -112,6 +121,15 @@ pub fn quad_quality(batch: &Batch) -> Vec<f32> {
                 &v[q[3] as usize],
             )
         })
+        .collect()
+}
+
+/// The kernel's entry point `quad_quality_local` on the CPU (precomputed-edges layout).
+pub fn quad_quality_local(locals: &[LocalQuad]) -> Vec<f32> {
+    locals
+        .par_iter()
+        .with_min_len(4096)
+        .map(|l| eta_from_angles(angles_from_edges(l.edges())))
         .collect()
 }
 

@@ -1,7 +1,7 @@
 //! Vulkan adapters and devices (created once, apart from the work) and the quality kernel
 //! on a device: [`Kernel`] (pipeline built once per device) and [`evaluate`].
 
-use super::layout::{Batch, Params, VERTEX_BYTES, Vertex};
+use super::layout::{Batch, LOCAL_QUAD_BYTES, Params, VERTEX_BYTES, Vertex};
 use super::{GpuError, shader};
 use std::borrow::Cow;
 use std::sync::{Mutex, mpsc};
@@ -79,6 +79,18 @@ impl Timings {
     }
 }
 
+/// How candidates reach the kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Layout {
+    /// Vertex positions once (32 bytes each) and four `u32` indices per candidate: the
+    /// fewest bytes over the bus; the kernel gathers four vertices per candidate.
+    #[default]
+    Indexed,
+    /// Five edge vectors per candidate precomputed on the host (64 bytes, entry point
+    /// `quad_quality_local`): more bytes over the bus, but the kernel streams without gather.
+    Local,
+}
+
 /// The quality pipeline on one device, built once and reused for every batch.
 #[derive(Debug)]
 pub struct Kernel {
@@ -87,6 +99,7 @@ pub struct Kernel {
     timestamps: bool,
     max_chunk: usize,
     max_vertices: usize,
+    kind: Layout,
     buffers: Mutex<Option<Buffers>>,
 }
 
@@ -118,6 +131,7 @@ impl Buffers {
         vertex_cap: usize,
         chunk: usize,
         timestamps: bool,
+        kind: Layout,
     ) -> Buffers {
         use wgpu::BufferUsages as U;
         let buffer = |label: &str, size: usize, usage: wgpu::BufferUsages| {
@@ -134,18 +148,25 @@ impl Buffers {
             vertex_cap * VERTEX_BYTES,
             U::STORAGE | U::COPY_DST,
         );
-        let quads = buffer("quads", chunk * 16, U::STORAGE | U::COPY_DST);
+        let per_candidate = match kind {
+            Layout::Indexed => 16,
+            Layout::Local => LOCAL_QUAD_BYTES,
+        };
+        let quads = buffer("quads", chunk * per_candidate, U::STORAGE | U::COPY_DST);
         let eta = buffer("eta", chunk * 4, U::STORAGE | U::COPY_SRC);
         let read = buffer("eta readback", chunk * 4, U::MAP_READ | U::COPY_DST);
         let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("quad_quality"),
             layout,
-            entries: &[
-                entry(0, &params),
-                entry(1, &vertices),
-                entry(2, &quads),
-                entry(3, &eta),
-            ],
+            entries: &match kind {
+                Layout::Indexed => vec![
+                    entry(0, &params),
+                    entry(1, &vertices),
+                    entry(2, &quads),
+                    entry(3, &eta),
+                ],
+                Layout::Local => vec![entry(0, &params), entry(3, &eta), entry(4, &quads)],
+            },
         });
         let queries = timestamps.then(|| {
             let set = device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -223,16 +244,21 @@ fn read_back(device: &wgpu::Device, buffer: &wgpu::Buffer, len: u64) -> Result<V
 impl Kernel {
     /// Validates the shader with naga and builds the pipeline on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Kernel, GpuError> {
-        Kernel::build(device, 0)
+        Kernel::build(device, 0, Layout::Indexed)
+    }
+
+    /// The kernel for a given candidate [`Layout`].
+    pub fn with_layout(device: &wgpu::Device, layout: Layout) -> Result<Kernel, GpuError> {
+        Kernel::build(device, 0, layout)
     }
 
     /// A diagnostic for the benchmark: the kernel's memory accesses (indices, four vertex
     /// gathers, one write) with almost no arithmetic. Its output is not eta.
-    pub fn memory_only(device: &wgpu::Device) -> Result<Kernel, GpuError> {
-        Kernel::build(device, 1)
+    pub fn memory_only(device: &wgpu::Device, layout: Layout) -> Result<Kernel, GpuError> {
+        Kernel::build(device, 1, layout)
     }
 
-    fn build(device: &wgpu::Device, mode: u32) -> Result<Kernel, GpuError> {
+    fn build(device: &wgpu::Device, mode: u32, kind: Layout) -> Result<Kernel, GpuError> {
         shader::validate(shader::QUAD_QUALITY, shader::QUAD_QUALITY_PATH)?;
         let pipeline = checked(device, "building the quality pipeline", || {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -243,7 +269,10 @@ impl Kernel {
                 label: Some("quad_quality"),
                 layout: None,
                 module: &module,
-                entry_point: Some(shader::ENTRY_POINT),
+                entry_point: Some(match kind {
+                    Layout::Indexed => shader::ENTRY_POINT,
+                    Layout::Local => shader::ENTRY_POINT_LOCAL,
+                }),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants: &[("MODE", mode as f64)],
                     ..Default::default()
@@ -258,6 +287,7 @@ impl Kernel {
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             max_chunk: usize::MAX,
             max_vertices: usize::MAX,
+            kind,
             buffers: Mutex::new(None),
         })
     }
@@ -297,9 +327,12 @@ impl Kernel {
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size) as usize;
         let wg_max = limits.max_compute_workgroups_per_dimension as usize;
-        let whole = batch.vertices.len() * VERTEX_BYTES <= bind_max
-            && batch.vertices.len() <= self.max_vertices;
-        let mut chunk = (bind_max / 16)
+        let local = self.kind == Layout::Local;
+        let whole = local
+            || batch.vertices.len() * VERTEX_BYTES <= bind_max
+                && batch.vertices.len() <= self.max_vertices;
+        let per_candidate = if local { LOCAL_QUAD_BYTES } else { 16 };
+        let mut chunk = (bind_max / per_candidate)
             .min(wg_max.saturating_mul(wg_max).saturating_mul(WORKGROUP))
             .min(self.max_chunk)
             .min(n);
@@ -310,7 +343,9 @@ impl Kernel {
                 .min(self.max_vertices / 4)
                 .max(1);
         }
-        let vertex_cap = if whole {
+        let vertex_cap = if local {
+            0
+        } else if whole {
             batch.vertices.len()
         } else {
             (4 * chunk).min(batch.vertices.len())
@@ -325,7 +360,14 @@ impl Kernel {
         {
             *cache = None; // free the old ones first
             *cache = Some(checked(device, "allocating buffers", || {
-                Buffers::new(device, &self.layout, vertex_cap, chunk, self.timestamps)
+                Buffers::new(
+                    device,
+                    &self.layout,
+                    vertex_cap,
+                    chunk,
+                    self.timestamps,
+                    self.kind,
+                )
             })?);
         }
         let bufs = cache.as_ref().expect("just allocated");
@@ -368,7 +410,10 @@ impl Kernel {
             // Upload.
             let t = Instant::now();
             queue.write_buffer(params_buf, 0, bytemuck::bytes_of(&params));
-            if whole {
+            if local {
+                let locals = batch.local_quads(start..start + count);
+                queue.write_buffer(quad_buf, 0, bytemuck::cast_slice(&locals));
+            } else if whole {
                 if start == 0 {
                     queue.write_buffer(vertex_buf, 0, bytemuck::cast_slice(&batch.vertices));
                 }

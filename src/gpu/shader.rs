@@ -10,6 +10,9 @@ pub const QUAD_QUALITY_PATH: &str = "shaders/quad_quality.wgsl";
 pub const QUAD_QUALITY: &str = include_str!("../../shaders/quad_quality.wgsl");
 /// Entry point of the quality kernel (the CPU twin is `gpu::cpu::quad_quality`).
 pub const ENTRY_POINT: &str = "quad_quality";
+/// Entry point of the quality kernel on the precomputed-edges layout (CPU twin:
+/// `gpu::cpu::quad_quality_local`).
+pub const ENTRY_POINT_LOCAL: &str = "quad_quality_local";
 /// Path of the streaming-copy kernel (bandwidth measurement).
 pub const STREAM_COPY_PATH: &str = "shaders/stream_copy.wgsl";
 /// Source of the streaming-copy kernel; entry point `stream_copy`.

@@ -6,7 +6,7 @@
 //! when `CI` is set: then they fail.
 
 use crate::util::{SEED, repo_path};
-use quadrecomb::gpu::{self, Backend, Batch, Evaluator, Kernel, layout::Vertex};
+use quadrecomb::gpu::{self, Backend, Batch, Evaluator, Kernel, Layout, layout::Vertex};
 use quadrecomb::mesh::{Mesh, MeshData};
 use quadrecomb::quality::{self, CandidateTable};
 use rand::{RngExt, SeedableRng};
@@ -53,6 +53,7 @@ struct Dev {
     device: wgpu::Device,
     queue: wgpu::Queue,
     kernel: Kernel,
+    local: Kernel,
 }
 
 /// The test device, opened once: the first adapter the loader gives (point
@@ -77,10 +78,12 @@ fn dev() -> Option<&'static Dev> {
             "GPU tests run on: {name} (timestamps: {})",
             kernel.has_timestamps()
         );
+        let local = Kernel::with_layout(&device, Layout::Local).expect("build the local kernel");
         Some(Dev {
             device,
             queue,
             kernel,
+            local,
         })
     });
     if dev.is_none() {
@@ -97,6 +100,19 @@ fn run(d: &Dev, batch: &Batch) -> Vec<f32> {
         .run(&d.device, &d.queue, batch)
         .expect("kernel runs")
         .0
+}
+
+/// The precomputed-edges layout on the device and its CPU twin.
+fn run_local(d: &Dev, batch: &Batch) -> (Vec<f32>, Vec<f32>) {
+    let eta = d
+        .local
+        .run(&d.device, &d.queue, batch)
+        .expect("local kernel runs")
+        .0;
+    (
+        eta,
+        gpu::cpu::quad_quality_local(&batch.local_quads(0..batch.len())),
+    )
 }
 
 /// f64 angles of the quad, as `quality::quad_eta` computes them.
@@ -186,17 +202,20 @@ fn check_meshes(d: &Dev, meshes: &[(String, Mesh)]) {
     }
     let eta = run(d, &batch);
     let twin = gpu::cpu::quad_quality(&batch);
+    let (eta_local, twin_local) = run_local(d, &batch);
     for (((name, m), t), span) in meshes.iter().zip(&mut tables).zip(&batch.meshes) {
         let points: Vec<_> = t
             .quads
             .iter()
             .map(|q| q.map(|v| m.vertices[v as usize]))
             .collect();
+        let r = span.candidates.clone();
+        compare(name, &points, &eta[r.clone()], &twin[r.clone()]);
         compare(
-            name,
+            &format!("{name} [local edges]"),
             &points,
-            &eta[span.candidates.clone()],
-            &twin[span.candidates.clone()],
+            &eta_local[r.clone()],
+            &twin_local[r],
         );
         // The reference table built the usual way agrees too.
         let reference = CandidateTable::build(m);
@@ -472,6 +491,13 @@ fn device_matches_f64_on_adversarial_candidates() {
     let twin = gpu::cpu::quad_quality(&batch);
     let points: Vec<_> = cases.iter().map(|c| c.1).collect();
     let r = compare("adversarial (one mesh each)", &points, &eta, &twin);
+    let (eta_local, twin_local) = run_local(d, &batch);
+    compare(
+        "adversarial (one mesh each) [local edges]",
+        &points,
+        &eta_local,
+        &twin_local,
+    );
     assert!(r.zero > 100, "the adversarial set has non-convex cases");
     assert!(r.borderline >= 4, "the set exercises the borderline band");
     let size = |q: &[[f64; 3]; 4]| {
@@ -515,6 +541,13 @@ fn device_matches_f64_on_adversarial_candidates() {
         .collect();
     batch.push(&verts, &quads).unwrap();
     let shared_eta = run(d, &batch);
+    let (shared_local, shared_twin_local) = run_local(d, &batch);
+    compare(
+        "adversarial (one mesh, shared normalisation) [local edges]",
+        &shared,
+        &shared_local,
+        &shared_twin_local,
+    );
     compare(
         "adversarial (one mesh, shared normalisation)",
         &shared,

@@ -3,7 +3,8 @@
 //! GPU), split into upload, kernel and readback, against the device's memory-bandwidth bound.
 
 use anyhow::Context;
-use quadrecomb::gpu::{self, Batch, Kernel, Timings, synthetic};
+use quadrecomb::gpu::layout::LOCAL_QUAD_BYTES;
+use quadrecomb::gpu::{self, Batch, Kernel, Layout, Timings, synthetic};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -115,8 +116,28 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     "submit + wait"
                 }
             );
-            let memory_only = Kernel::memory_only(&device)?;
-            devices.push((name, device, queue, kernel, memory_only, bw));
+            let kernels = vec![
+                (kernel, "indexed", true, Layout::Indexed),
+                (
+                    Kernel::with_layout(&device, Layout::Local)?,
+                    "local edges",
+                    true,
+                    Layout::Local,
+                ),
+                (
+                    Kernel::memory_only(&device, Layout::Indexed)?,
+                    "indexed, memory accesses only, diagnostic",
+                    false,
+                    Layout::Indexed,
+                ),
+                (
+                    Kernel::memory_only(&device, Layout::Local)?,
+                    "local edges, memory accesses only, diagnostic",
+                    false,
+                    Layout::Local,
+                ),
+            ];
+            devices.push((name, device, queue, kernels, bw));
         }
     }
     println!("host: {threads} threads for the CPU rows");
@@ -133,9 +154,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let bytes = batch.bytes_per_candidate();
         println!(
             "\n{c} candidates ({n}x{n} jittered grid, {} vertices): host batch preparation \
-             (f64 -> hi/lo f32, index offsets) {:.2} ms; at least {bytes:.1} bytes per candidate",
+             (f64 -> hi/lo f32, index offsets) {:.2} ms; at least {bytes:.1} bytes per candidate \
+             indexed, {} with local edges",
             vertices.len(),
-            prepare_s * 1e3
+            prepare_s * 1e3,
+            LOCAL_QUAD_BYTES + 4
         );
         let reference: Vec<f64> = {
             use rayon::prelude::*;
@@ -197,15 +220,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             gpu::cpu::quad_quality(&batch)
         })?);
 
-        for (name, device, queue, kernel, memory_only, bw) in &devices {
-            for (k, label, is_eta) in [
-                (kernel, name.clone(), true),
-                (
-                    memory_only,
-                    format!("{name} [memory accesses only, diagnostic]"),
-                    false,
-                ),
-            ] {
+        for (name, device, queue, kernels, bw) in &devices {
+            for (k, what, is_eta, layout) in kernels {
+                let label = format!("{name} [{what}]");
+                let bytes = match layout {
+                    Layout::Indexed => bytes,
+                    Layout::Local => (LOCAL_QUAD_BYTES + 4) as f64,
+                };
                 k.run(device, queue, &batch)?; // warm-up
                 let (eta, t, total) = best_of(args.repeat, || {
                     let s = Instant::now();
