@@ -23,30 +23,24 @@ struct Vertex {
 }
 
 /// Mirrors `gpu::layout::Params`: one dispatch's candidate count, the number of
-/// invocations per row of the 2D grid, and the index subtracted from every vertex index.
+/// invocations per row of the 2D grid, the index subtracted from every vertex index, and
+/// the stride between the four planes of the local layout.
 struct Params {
     count: u32,
     row: u32,
     vertex_base: u32,
-    pad: u32,
-}
-
-/// Mirrors `gpu::layout::LocalQuad`: one candidate's five edge vectors, computed on the
-/// host from f64 and each scaled to a largest component of 1, packed into four vec4:
-/// [a.xyz e0.x] [e0.yz e1.xy] [e1.z f0.xyz] [f1.xyz -], with a = s1 - s0, e0 = o0 - s0,
-/// e1 = o1 - s0, f0 = o0 - s1, f1 = o1 - s1.
-struct LocalQuad {
-    p: vec4<f32>,
-    q: vec4<f32>,
-    r: vec4<f32>,
-    s: vec4<f32>,
+    plane: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> vertices: array<Vertex>;
 @group(0) @binding(2) var<storage, read> quads: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read_write> eta: array<f32>;
-@group(0) @binding(4) var<storage, read> locals: array<LocalQuad>;
+/// The local layout (`gpu::layout::LocalQuad`), as four planes of vec4: candidate i's
+/// [a.xyz e0.x] [e0.yz e1.xy] [e1.z f0.xyz] [f1.xyz -] at i, plane + i, 2 plane + i,
+/// 3 plane + i, with a = s1 - s0, e0 = o0 - s0, e1 = o1 - s0, f0 = o0 - s1, f1 = o1 - s1
+/// computed on the host from f64, each scaled to a largest component of 1.
+@group(0) @binding(4) var<storage, read> locals: array<vec4<f32>>;
 
 const PI: f32 = 3.14159265358979;
 const FRAC_PI_2: f32 = 1.57079632679490;
@@ -130,25 +124,29 @@ fn quad_quality(@builtin(global_invocation_id) gid: vec3<u32>) {
     eta[i] = quad_eta(s0, o1, s1, o0);
 }
 
-/// The same function on the precomputed-edges layout: streams 64 bytes per candidate, no
-/// gather. CPU twin: `gpu::cpu::quad_quality_local`.
+/// The same function on the precomputed-edges layout: streams 64 bytes per candidate in
+/// four coalesced planes, no gather. CPU twin: `gpu::cpu::quad_quality_local`.
 @compute @workgroup_size(256)
 fn quad_quality_local(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.y * params.row + gid.x;
     if i >= params.count {
         return;
     }
-    let l = locals[i];
+    let n = params.plane;
+    let p = locals[i];
+    let q = locals[n + i];
+    let r = locals[2u * n + i];
+    let s = locals[3u * n + i];
     if MODE == 1u {
-        let m = l.p + l.q + l.r + l.s;
+        let m = p + q + r + s;
         eta[i] = m.x + m.y + m.z + m.w;
         return;
     }
     eta[i] = eta_from_edges(
-        l.p.xyz,
-        vec3<f32>(l.p.w, l.q.x, l.q.y),
-        vec3<f32>(l.q.z, l.q.w, l.r.x),
-        l.r.yzw,
-        l.s.xyz,
+        p.xyz,
+        vec3<f32>(p.w, q.x, q.y),
+        vec3<f32>(q.z, q.w, r.x),
+        r.yzw,
+        s.xyz,
     );
 }

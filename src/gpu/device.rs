@@ -404,15 +404,15 @@ impl Kernel {
                 count: count as u32,
                 row: (gx * WORKGROUP) as u32,
                 vertex_base: 0,
-                pad: 0,
+                plane: count as u32,
             };
 
             // Upload.
             let t = Instant::now();
             queue.write_buffer(params_buf, 0, bytemuck::bytes_of(&params));
             if local {
-                let locals = batch.local_quads(start..start + count);
-                queue.write_buffer(quad_buf, 0, bytemuck::cast_slice(&locals));
+                let planes = batch.local_planes(start..start + count);
+                queue.write_buffer(quad_buf, 0, bytemuck::cast_slice(&planes));
             } else if whole {
                 if start == 0 {
                     queue.write_buffer(vertex_buf, 0, bytemuck::cast_slice(&batch.vertices));

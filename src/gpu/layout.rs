@@ -16,8 +16,8 @@ pub struct Vertex {
 }
 
 /// Mirrors WGSL `struct Params` in `shaders/quad_quality.wgsl`: one dispatch's candidate
-/// count, invocations per row of the 2D dispatch grid, and the index subtracted from every
-/// vertex index (where a dispatch binds a window of the vertex buffer). 16 bytes.
+/// count, invocations per row of the 2D dispatch grid, the index subtracted from every
+/// vertex index, and the stride (in vec4) between the local layout's four planes. 16 bytes.
 #[allow(unsafe_code)] // the bytemuck derives expand to `unsafe impl`
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, bytemuck::Pod, bytemuck::Zeroable)]
@@ -25,13 +25,15 @@ pub struct Params {
     pub count: u32,
     pub row: u32,
     pub vertex_base: u32,
-    pub pad: u32,
+    pub plane: u32,
 }
 
-/// Mirrors WGSL `struct LocalQuad` in `shaders/quad_quality.wgsl`: one candidate's five
-/// edge vectors `a = s1 - s0, e0 = o0 - s0, e1 = o1 - s0, f0 = o0 - s1, f1 = o1 - s1`,
-/// computed in f64 and each scaled to a largest component of 1, packed as
-/// `[a.xyz e0.x] [e0.yz e1.xy] [e1.z f0.xyz] [f1.xyz 0]`. 64 bytes, read without gather.
+/// One candidate of the local layout, mirroring WGSL `locals` in `shaders/quad_quality.wgsl`
+/// (which holds `v[0..4]`, `v[4..8]`, `v[8..12]`, `v[12..16]` in four planes, see
+/// [`Batch::local_planes`]): the five edge vectors `a = s1 - s0, e0 = o0 - s0,
+/// e1 = o1 - s0, f0 = o0 - s1, f1 = o1 - s1`, computed in f64 and each scaled to a largest
+/// component of 1, packed as `[a.xyz e0.x] [e0.yz e1.xy] [e1.z f0.xyz] [f1.xyz 0]`.
+/// 64 bytes, read without gather.
 #[allow(unsafe_code)] // the bytemuck derives expand to `unsafe impl`
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, bytemuck::Pod, bytemuck::Zeroable)]
@@ -187,6 +189,24 @@ impl Batch {
             .with_min_len(4096)
             .map(|q| LocalQuad::new(q.map(|i| f64_of(&self.vertices[i as usize]))))
             .collect()
+    }
+
+    /// The local layout of candidates `range` as the kernel reads it: four planes of
+    /// `range.len()` vec4 each (plane k holds `v[4k..4k + 4]` of every [`LocalQuad`]).
+    pub fn local_planes(&self, range: Range<usize>) -> Vec<[f32; 4]> {
+        use rayon::prelude::*;
+        let locals = self.local_quads(range);
+        let n = locals.len();
+        let mut planes = vec![[0.0f32; 4]; 4 * n];
+        planes
+            .par_chunks_mut(n.max(1))
+            .enumerate()
+            .for_each(|(k, plane)| {
+                for (dst, l) in plane.iter_mut().zip(&locals) {
+                    dst.copy_from_slice(&l.v[4 * k..4 * k + 4]);
+                }
+            });
+        planes
     }
 
     /// Bytes the kernel must move per candidate at least: indices read, eta written, and

@@ -591,6 +591,14 @@ fn chunked_dispatches_and_vertex_compaction_give_identical_results() {
     );
     assert_eq!(a, whole);
     assert_eq!(b, whole);
+    // The local layout, whole and in chunks of 1000 candidates (plane stride per chunk).
+    let (local_whole, _) = d.local.run(&d.device, &d.queue, &batch).unwrap();
+    let chunked_local = Kernel::with_layout(&d.device, Layout::Local)
+        .unwrap()
+        .with_caps(1000, usize::MAX);
+    let (c, t) = chunked_local.run(&d.device, &d.queue, &batch).unwrap();
+    assert_eq!(t.dispatches, batch.len().div_ceil(1000));
+    assert_eq!(c, local_whole);
     let empty = d.kernel.run(&d.device, &d.queue, &Batch::new()).unwrap().0;
     assert!(empty.is_empty());
 }
