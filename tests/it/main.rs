@@ -2,5 +2,6 @@
 
 mod io;
 mod meshes;
+mod optimum;
 mod search;
 mod util;
