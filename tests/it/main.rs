@@ -4,4 +4,5 @@ mod gpu;
 mod io;
 mod meshes;
 mod optimum;
+mod search;
 mod util;
