@@ -261,8 +261,8 @@ fn oracle_sample_meshes_cover_the_cases() {
         "a mesh in pieces"
     );
     assert!(
-        all.iter().any(|(_, m)| m.num_triangles() >= 250),
-        "a mesh of a few hundred triangles"
+        all.iter().any(|(_, m)| m.num_triangles() >= 180),
+        "a mesh of a couple of hundred triangles"
     );
     for (name, mesh) in &all {
         mesh.sanity_check()
@@ -430,115 +430,70 @@ fn harness_reports_verdicts_changed_far_away() {
 // ---------------------------------------------------------------------------------------------
 // Meshes for the comparison.
 
-/// A varied set of meshes, named by how to rebuild them.
+/// A varied set of meshes of up to about two hundred triangles, named by how to rebuild them.
 fn sample_meshes(seed: u64) -> Vec<(String, Mesh)> {
-    let mut out: Vec<(String, Mesh)> = Vec::new();
-    out.push(("strip(6)".into(), meshes::strip(6)));
-    out.push(("strip(5)".into(), meshes::strip(5)));
-    out.push(("grid 4x4 rising".into(), Grid::plain(4, 4).build().unwrap()));
-    let grid = |nx, ny, diagonals, holes, drop, quads, surfaces, s: u64| Grid {
-        nx,
-        ny,
+    let mut out: Vec<(String, Mesh)> = vec![
+        ("strip(6)".into(), meshes::strip(6)),
+        ("strip(5)".into(), meshes::strip(5)),
+        ("grid 4x4 rising".into(), Grid::plain(4, 4).build().unwrap()),
+    ];
+    let grid = |nx, ny, s: u64| Grid {
         jitter: 0.2,
-        diagonals,
-        holes,
-        drop,
-        quads,
-        surfaces,
-        flip: Vec::new(),
+        diagonals: Diagonals::Random,
         seed: seed ^ s,
+        ..Grid::plain(nx, ny)
     };
     let specs = [
-        (
-            "jittered 12x12 random diagonals",
-            grid(12, 12, Diagonals::Random, 0.0, 0.0, 0.0, Surfaces::One, 1),
-        ),
-        (
-            "jittered 15x10 holes",
-            grid(15, 10, Diagonals::Random, 0.12, 0.0, 0.0, Surfaces::One, 2),
-        ),
-        (
-            "jittered 12x12 dropped triangles",
-            grid(12, 12, Diagonals::Random, 0.0, 0.03, 0.0, Surfaces::One, 3),
-        ),
-        (
-            "jittered 14x10 quadrants",
-            grid(
-                14,
-                10,
-                Diagonals::Random,
-                0.05,
-                0.02,
-                0.0,
-                Surfaces::Quadrants,
-                4,
-            ),
-        ),
-        (
-            "jittered 15x9 bands",
-            grid(
-                15,
-                9,
-                Diagonals::Alternating,
-                0.0,
-                0.02,
-                0.0,
-                Surfaces::Bands(4),
-                5,
-            ),
-        ),
-        (
-            "jittered 10x10 random cell surfaces",
-            grid(
-                10,
-                10,
-                Diagonals::Random,
-                0.05,
-                0.0,
-                0.0,
-                Surfaces::RandomCells(3),
-                6,
-            ),
-        ),
-        (
-            "jittered 8x8 random triangle surfaces",
-            grid(
-                8,
-                8,
-                Diagonals::Random,
-                0.0,
-                0.0,
-                0.0,
-                Surfaces::RandomTriangles(2),
-                7,
-            ),
-        ),
-        (
-            "jittered 12x12 input quads and holes",
-            grid(
-                12,
-                12,
-                Diagonals::Random,
-                0.08,
-                0.02,
-                0.08,
-                Surfaces::One,
-                8,
-            ),
-        ),
-        (
-            "jittered 20x8 sparse (many holes)",
-            grid(20, 8, Diagonals::Random, 0.3, 0.05, 0.0, Surfaces::One, 9),
-        ),
+        grid(10, 9, 1),
+        Grid {
+            holes: 0.12,
+            ..grid(12, 8, 2)
+        },
+        Grid {
+            drop: 0.03,
+            ..grid(10, 9, 3)
+        },
+        Grid {
+            holes: 0.05,
+            drop: 0.02,
+            surfaces: Surfaces::Quadrants,
+            ..grid(12, 9, 4)
+        },
+        Grid {
+            drop: 0.02,
+            diagonals: Diagonals::Alternating,
+            surfaces: Surfaces::Bands(4),
+            ..grid(12, 8, 5)
+        },
+        Grid {
+            holes: 0.05,
+            surfaces: Surfaces::RandomCells(3),
+            ..grid(10, 10, 6)
+        },
+        Grid {
+            surfaces: Surfaces::RandomTriangles(2),
+            ..grid(8, 8, 7)
+        },
+        Grid {
+            holes: 0.08,
+            drop: 0.02,
+            quads: 0.08,
+            ..grid(10, 10, 8)
+        },
+        Grid {
+            holes: 0.3,
+            drop: 0.05,
+            ..grid(20, 8, 9)
+        },
     ];
-    for (name, spec) in specs {
+    for spec in specs {
         if let Some(mesh) = spec.build() {
-            out.push((format!("{name} {spec:?}"), mesh));
+            out.push((format!("{spec:?}"), mesh));
         }
     }
-    out.push(("icosphere(2)".into(), meshes::icosphere(2)));
+    out.push(("icosphere(1)".into(), meshes::icosphere(1)));
     for (k, (points, flips, drop, surfaces)) in
-        [(150, 200, 0.0, 1), (120, 150, 0.06, 1), (120, 100, 0.02, 2)]
+        [(90, 120, 0.0, 1), (100, 120, 0.06, 1), (120, 100, 0.02, 2)]
             .into_iter()
             .enumerate()
     {

@@ -16,6 +16,7 @@
 
 use quadrecomb::mesh::{Mesh, NONE};
 use quadrecomb::quality::CandidateTable;
+use std::cell::RefCell;
 
 /// Remaining triangles with an undo log, and the criterion computed from scratch on demand.
 #[derive(Debug, Clone)]
@@ -24,6 +25,16 @@ pub struct Naive {
     pairs: Vec<[u32; 2]>,
     remaining: Vec<bool>,
     log: Vec<u32>,
+    scratch: RefCell<Scratch>,
+}
+
+/// Reused search buffers (the searches themselves are from scratch every time).
+#[derive(Debug, Clone, Default)]
+struct Scratch {
+    /// `mark[t] == stamp`: reached by the current search (or excluded from it).
+    mark: Vec<u64>,
+    stamp: u64,
+    queue: Vec<u32>,
 }
 
 /// Everything the oracle says about one remaining set: the reference a fast state must equal.
@@ -54,6 +65,10 @@ impl Naive {
             pairs: table.pairs.clone(),
             remaining: vec![true; mesh.num_triangles()],
             log: Vec::new(),
+            scratch: RefCell::new(Scratch {
+                mark: vec![0; mesh.num_triangles()],
+                ..Scratch::default()
+            }),
         }
     }
 
@@ -97,51 +112,34 @@ impl Naive {
         self.remaining[b as usize] = true;
     }
 
-    /// Connected components of the dual graph restricted to the triangles where `keep` holds:
-    /// each component as its list of triangles, in order of first triangle.
-    fn components(&self, keep: &[bool]) -> Vec<Vec<u32>> {
-        let mut seen = vec![false; keep.len()];
-        let mut out = Vec::new();
-        for start in 0..keep.len() {
-            if !keep[start] || seen[start] {
-                continue;
-            }
-            seen[start] = true;
-            let mut comp = vec![start as u32];
-            let mut head = 0;
-            while head < comp.len() {
-                let t = comp[head];
-                head += 1;
-                for &u in &self.neighbours[t as usize] {
-                    if u != NONE && keep[u as usize] && !seen[u as usize] {
-                        seen[u as usize] = true;
-                        comp.push(u);
-                    }
+    /// Breadth-first search from `start` over remaining triangles not yet marked with the
+    /// current stamp, marking them; returns how many it reached.
+    fn bfs(&self, start: u32, scratch: &mut Scratch) -> usize {
+        let stamp = scratch.stamp;
+        scratch.mark[start as usize] = stamp;
+        scratch.queue.clear();
+        scratch.queue.push(start);
+        let mut head = 0;
+        while head < scratch.queue.len() {
+            let t = scratch.queue[head];
+            head += 1;
+            for &u in &self.neighbours[t as usize] {
+                if u != NONE && self.remaining[u as usize] && scratch.mark[u as usize] != stamp {
+                    scratch.mark[u as usize] = stamp;
+                    scratch.queue.push(u);
                 }
             }
-            out.push(comp);
         }
-        out
+        scratch.queue.len()
     }
 
     /// The polder of remaining triangle `t`: its component among remaining triangles (BFS).
     pub fn polder(&self, t: u32) -> Vec<u32> {
         assert!(self.remaining[t as usize], "polder of a used triangle");
-        let mut seen = vec![false; self.remaining.len()];
-        seen[t as usize] = true;
-        let mut out = vec![t];
-        let mut head = 0;
-        while head < out.len() {
-            let x = out[head];
-            head += 1;
-            for &u in &self.neighbours[x as usize] {
-                if u != NONE && self.remaining[u as usize] && !seen[u as usize] {
-                    seen[u as usize] = true;
-                    out.push(u);
-                }
-            }
-        }
-        out
+        let scratch = &mut *self.scratch.borrow_mut();
+        scratch.stamp += 1;
+        self.bfs(t, scratch);
+        scratch.queue.clone()
     }
 
     /// Sizes of the parts left when the two triangles of `c` leave their polder, and the
@@ -151,18 +149,25 @@ impl Naive {
         if !self.remaining[a as usize] || !self.remaining[b as usize] {
             return None;
         }
+        // P: a BFS from a over remaining triangles.
         let polder = self.polder(a);
         assert!(
             polder.contains(&b),
             "candidate {c}: t and t' in different polders"
         );
-        let mut keep = vec![false; self.remaining.len()];
+        // Parts: BFS over remaining triangles but a and b, from each triangle of P not yet
+        // reached. P is a component of the remaining triangles, so these searches stay in P.
+        let scratch = &mut *self.scratch.borrow_mut();
+        scratch.stamp += 1;
+        scratch.mark[a as usize] = scratch.stamp;
+        scratch.mark[b as usize] = scratch.stamp;
+        let mut parts = Vec::new();
         for &t in &polder {
-            keep[t as usize] = true;
+            if scratch.mark[t as usize] != scratch.stamp {
+                parts.push(self.bfs(t, scratch));
+            }
         }
-        keep[a as usize] = false;
-        keep[b as usize] = false;
-        let parts = self.components(&keep).iter().map(Vec::len).collect();
+        assert_eq!(parts.iter().sum::<usize>() + 2, polder.len());
         Some((polder.len(), parts))
     }
 
@@ -179,10 +184,15 @@ impl Naive {
 
     /// Number of odd components of the dual graph of all remaining triangles.
     pub fn odd_polders(&self) -> usize {
-        self.components(&self.remaining)
-            .iter()
-            .filter(|c| c.len() % 2 == 1)
-            .count()
+        let scratch = &mut *self.scratch.borrow_mut();
+        scratch.stamp += 1;
+        let mut odd = 0;
+        for t in 0..self.remaining.len() as u32 {
+            if self.remaining[t as usize] && scratch.mark[t as usize] != scratch.stamp {
+                odd += self.bfs(t, scratch) % 2;
+            }
+        }
+        odd
     }
 
     /// The same criterion stated globally, as a cross-check of [`Naive::is_allowed`]: apply
