@@ -7,6 +7,7 @@
 
 mod meshes;
 mod naive;
+mod state;
 mod walk;
 
 use meshes::{Diagonals, Grid, Surfaces};

@@ -16,6 +16,14 @@ pub trait Subject {
     fn allowed_count(&mut self, t: u32) -> u32;
     fn is_remaining(&mut self, t: u32) -> bool;
     fn allowed_actions(&mut self) -> Vec<u32>;
+    /// `P_1`, `P_2`, `P_3` as the state keeps them, in its own order, if it keeps them.
+    fn buckets(&mut self) -> Option<[Vec<u32>; 3]> {
+        None
+    }
+    /// The smallest k with `P_k` non-empty, if the state says.
+    fn min_k(&mut self) -> Option<Option<u32>> {
+        None
+    }
 }
 
 /// Shape of the walks.
@@ -115,6 +123,32 @@ pub fn compare<S: Subject>(
             got.len()
         ));
     }
+    if let Some(buckets) = subject.buckets() {
+        for (i, bucket) in buckets.iter().enumerate() {
+            let k = i as u32 + 1;
+            let mut got = bucket.clone();
+            got.sort_unstable();
+            got.dedup();
+            if got.len() != bucket.len() {
+                diffs.push(format!("bucket({k}) repeats triangles: {bucket:?}"));
+            }
+            let expected: Vec<u32> = (0..v.count.len() as u32)
+                .filter(|&t| v.remaining[t as usize] && v.count[t as usize] == k)
+                .collect();
+            if got != expected {
+                diffs.push(format!(
+                    "bucket({k}) (P_{k}): expected {expected:?}, got {got:?}"
+                ));
+            }
+        }
+    }
+    if let Some(got) = subject.min_k() {
+        let expected =
+            (1..=3).find(|&k| v.count.iter().zip(&v.remaining).any(|(&n, &r)| r && n == k));
+        if got != expected {
+            diffs.push(format!("min_k(): expected {expected:?}, got {got:?}"));
+        }
+    }
     if diffs.is_empty() {
         return Ok(v);
     }
@@ -157,6 +191,8 @@ pub fn walk<S: Subject>(
     stats.checks += 1;
     let mut allowed = initial.allowed_actions();
     let mut step = 0;
+    // P_k buckets before each applied action, to check that undo restores their order.
+    let mut saved = Vec::new();
     while !allowed.is_empty() {
         for e in 0..rng.random_range(0..=config.explorations) {
             let max_depth = rng.random_range(1..=config.max_depth);
@@ -168,15 +204,17 @@ pub fn walk<S: Subject>(
                 let what;
                 if go_down {
                     let c = here[rng.random_range(0..here.len())];
-                    subject.apply(c);
-                    oracle.apply(c);
+                    apply(subject, &mut oracle, &mut saved, c);
                     depth += 1;
                     stats.applies += 1;
                     what = format!("exploration {e}, op {op}: after apply({c})");
                 } else if depth > 0 {
-                    let c = *oracle.path().last().unwrap();
-                    subject.undo();
-                    oracle.undo();
+                    let c = undo(
+                        subject,
+                        &mut oracle,
+                        &mut saved,
+                        &ctx(step, &format!("exploration {e}, op {op}")),
+                    )?;
                     depth -= 1;
                     stats.undos += 1;
                     what = format!("exploration {e}, op {op}: after undo() of {c}");
@@ -187,9 +225,12 @@ pub fn walk<S: Subject>(
                 stats.checks += 1;
             }
             while depth > 0 {
-                let c = *oracle.path().last().unwrap();
-                subject.undo();
-                oracle.undo();
+                let c = undo(
+                    subject,
+                    &mut oracle,
+                    &mut saved,
+                    &ctx(step, &format!("exploration {e}, unwinding")),
+                )?;
                 depth -= 1;
                 stats.undos += 1;
                 compare(
@@ -204,8 +245,7 @@ pub fn walk<S: Subject>(
             }
         }
         let c = allowed[rng.random_range(0..allowed.len())];
-        subject.apply(c);
-        oracle.apply(c);
+        apply(subject, &mut oracle, &mut saved, c);
         stats.applies += 1;
         step += 1;
         allowed = compare(
@@ -220,9 +260,13 @@ pub fn walk<S: Subject>(
     stats.left = (0..mesh.num_triangles() as u32)
         .filter(|&t| oracle.is_remaining(t))
         .count();
-    while let Some(&c) = oracle.path().last() {
-        subject.undo();
-        oracle.undo();
+    while !oracle.path().is_empty() {
+        let c = undo(
+            subject,
+            &mut oracle,
+            &mut saved,
+            &ctx(step, "undoing the whole walk"),
+        )?;
         stats.undos += 1;
         let v = compare(
             subject,
@@ -240,4 +284,38 @@ pub fn walk<S: Subject>(
         }
     }
     Ok(stats)
+}
+
+/// Applies `c` to both, remembering the state's P_k buckets from before.
+fn apply<S: Subject>(
+    subject: &mut S,
+    oracle: &mut Naive,
+    saved: &mut Vec<Option<[Vec<u32>; 3]>>,
+    c: u32,
+) {
+    saved.push(subject.buckets());
+    subject.apply(c);
+    oracle.apply(c);
+}
+
+/// Undoes the last action on both; the state's P_k buckets must be back in the order they had
+/// before that action (so that runs are reproducible whatever the tree explored).
+fn undo<S: Subject>(
+    subject: &mut S,
+    oracle: &mut Naive,
+    saved: &mut Vec<Option<[Vec<u32>; 3]>>,
+    context: &str,
+) -> Result<u32, String> {
+    let c = *oracle.path().last().expect("something to undo");
+    subject.undo();
+    oracle.undo();
+    let before = saved.pop().expect("saved buckets");
+    let now = subject.buckets();
+    if now != before {
+        return Err(format!(
+            "P_k buckets not restored in order by undo() of {c}: {context}\n  path: {:?}\n  before apply: {before:?}\n  after undo:   {now:?}",
+            oracle.path()
+        ));
+    }
+    Ok(c)
 }
