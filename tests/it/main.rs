@@ -5,4 +5,5 @@ mod io;
 mod meshes;
 mod optimum;
 mod search;
+mod search_oracle;
 mod util;
