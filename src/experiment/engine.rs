@@ -60,13 +60,14 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
     } else {
         100.0 * 2.0 * out.quads as f64 / mesh.triangles as f64
     };
+    // A tree of horizon h expands the nodes at depths 0..h-1: 1 + b + ... + b^(h-1) per
+    // decision. Solve for b (the nodes below the root: b + ... + b^(h-1) = N - 1). A tree of
+    // horizon 1 expands only its root, whatever its width: no branching factor.
     let branching_factor = match job.horizon {
-        Some(h) if out.decisions > 0 => {
-            effective_branching_factor(out.nodes_expanded as f64 / out.decisions as f64, h)
-        }
-        None if job.algo == "greedy" && out.decisions > 0 => {
-            effective_branching_factor(out.nodes_expanded as f64 / out.decisions as f64, 1)
-        }
+        Some(h) if h >= 2 && out.decisions > 0 => effective_branching_factor(
+            out.nodes_expanded as f64 / out.decisions as f64 - 1.0,
+            h - 1,
+        ),
         _ => None,
     };
     RunRecord {
@@ -356,8 +357,8 @@ pub(crate) mod tests {
         let r = make_record(&m, &job, out);
         assert_eq!(r.quality_pct, Some(75.0));
         assert_eq!(r.recombined_pct, 80.0);
-        // b + b^2 = 6 -> b = 2.
-        assert!((r.branching_factor.unwrap() - 2.0).abs() < 1e-9);
+        // 6 nodes expanded per decision at h = 2: 1 + b = 6 -> b = 5.
+        assert!((r.branching_factor.unwrap() - 5.0).abs() < 1e-9);
         assert_eq!(r.seed, job.seed);
     }
 }

@@ -127,7 +127,7 @@ pub(crate) mod tests {
         fn run(&mut self, job: &Job) -> Result<Outcome, ExperimentError> {
             self.runs += 1;
             if self.factory.fail_on_run == Some(job.run) {
-                return Err(ExperimentError::Backend(format!("job {} failed", job.run)));
+                return Err(ExperimentError::Run(format!("job {} failed", job.run)));
             }
             Ok(fake_outcome(job))
         }

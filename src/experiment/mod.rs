@@ -16,6 +16,7 @@ pub mod record;
 pub mod seed;
 pub mod store;
 pub mod summary;
+//SWEEP
 
 pub use seed::{derive_seed, mesh_hash};
 
@@ -64,9 +65,21 @@ pub enum ExperimentError {
     /// The sweep configuration is invalid.
     #[error("{0}")]
     Invalid(String),
-    /// Computing qualities or the optimum failed.
+    /// Computing qualities failed.
+    #[error("computing quad qualities")]
+    Gpu(#[from] crate::gpu::GpuError),
+    /// A mesh could not be loaded.
+    #[error("loading mesh {spec}")]
+    Mesh {
+        /// The mesh as given.
+        spec: String,
+        /// The cause.
+        #[source]
+        source: crate::mesh::ReadError,
+    },
+    /// A run failed.
     #[error("{0}")]
-    Backend(String),
+    Run(String),
 }
 
 impl ExperimentError {
@@ -87,6 +100,7 @@ impl ExperimentError {
                 | ExperimentError::AlreadyExists { .. }
                 | ExperimentError::Merge(_)
                 | ExperimentError::Invalid(_)
+                | ExperimentError::Mesh { .. }
         )
     }
 }

@@ -42,9 +42,11 @@ pub struct RunRecord {
     pub nodes_expanded: u64,
     /// Actions applied (decisions taken) by the search; quads for "optimum".
     pub decisions: u64,
-    /// Effective branching factor of the look-ahead tree: the b with
-    /// b + b^2 + ... + b^h = nodes_expanded / decisions (see
-    /// [`crate::stats::describe::effective_branching_factor`]); `None` without a tree or decisions.
+    /// Effective branching factor of the look-ahead tree, for `uniform` and `selective` with
+    /// h >= 2: the b with 1 + b + ... + b^(h-1) = nodes_expanded / decisions (a tree of horizon
+    /// h expands the nodes of depths 0..h-1; see
+    /// [`crate::stats::describe::effective_branching_factor`]). `None` for h = 1 (only the root
+    /// is expanded, whatever its width), for the other algorithms, and without decisions.
     pub branching_factor: Option<f64>,
     /// Name of the evaluator that computed eta ("cpu-twin", "vulkan: llvmpipe ...", ...).
     pub backend: String,
