@@ -16,7 +16,7 @@ pub mod record;
 pub mod seed;
 pub mod store;
 pub mod summary;
-//SWEEP
+pub mod sweep;
 
 pub use seed::{derive_seed, mesh_hash};
 

@@ -3,5 +3,6 @@
 mod io;
 mod meshes;
 mod optimum;
+mod runner;
 mod search;
 mod util;
