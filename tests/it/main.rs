@@ -1,3 +1,4 @@
 //! The one integration-test binary: each module tests one area through the library or the CLI.
 
+mod report;
 mod util;
