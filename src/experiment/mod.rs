@@ -1,1 +1,118 @@
 //! Experiments: seeded, parallel, resumable horizon sweeps and their run records.
+//!
+//! A sweep is a [`manifest::SweepSpec`] (meshes, algorithms, horizons, runs, base seed) turned
+//! into a run list ([`plan`]), each run with a seed derived from what it is, never from where or
+//! when it runs ([`seed`]). Runs execute on a thread pool ([`exec`]), each finished run is one
+//! flushed line of `runs.jsonl` ([`store`]), and the directory can be resumed after a kill,
+//! split into shards and merged back ([`merge`]). [`summary`] turns records into statistics.
+
+pub mod engine;
+pub mod exec;
+pub mod manifest;
+pub mod merge;
+pub mod plan;
+pub mod progress;
+pub mod record;
+pub mod seed;
+pub mod store;
+pub mod summary;
+//SWEEP
+
+pub use seed::{derive_seed, mesh_hash};
+
+use std::path::{Path, PathBuf};
+
+/// Errors of the experiment runner.
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A results file holds something that is not what the runner writes.
+    #[error("{path}: corrupt: {message}")]
+    Corrupt {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A results directory belongs to another configuration than the one asked for.
+    #[error("{dir}: holds results of a different configuration: {message}")]
+    Mismatch {
+        /// The directory.
+        dir: PathBuf,
+        /// The first difference found.
+        message: String,
+    },
+    /// The output directory already holds runs and `--resume` was not given.
+    #[error(
+        "{dir}: already holds {records} run(s); pass --resume to continue that sweep, or choose another --out"
+    )]
+    AlreadyExists {
+        /// The directory.
+        dir: PathBuf,
+        /// Records found.
+        records: usize,
+    },
+    /// Shards cannot be merged: missing, duplicated or foreign runs.
+    #[error("merge: {0}")]
+    Merge(String),
+    /// The sweep configuration is invalid.
+    #[error("{0}")]
+    Invalid(String),
+    /// Computing qualities failed.
+    #[error("computing quad qualities")]
+    Gpu(#[from] crate::gpu::GpuError),
+    /// A mesh could not be loaded.
+    #[error("loading mesh {spec}")]
+    Mesh {
+        /// The mesh as given.
+        spec: String,
+        /// The cause.
+        #[source]
+        source: crate::mesh::ReadError,
+    },
+    /// A run failed.
+    #[error("{0}")]
+    Run(String),
+}
+
+impl ExperimentError {
+    pub(crate) fn io(path: &Path, source: std::io::Error) -> ExperimentError {
+        ExperimentError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    /// Whether the user's input (arguments, directories) is at fault rather than the program
+    /// or the system.
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            ExperimentError::Corrupt { .. }
+                | ExperimentError::Mismatch { .. }
+                | ExperimentError::AlreadyExists { .. }
+                | ExperimentError::Merge(_)
+                | ExperimentError::Invalid(_)
+                | ExperimentError::Mesh { .. }
+        )
+    }
+}
+
+/// Writes a file through a temporary sibling and a rename, so readers never see half of it.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExperimentError> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    std::fs::write(&tmp, bytes).map_err(|e| ExperimentError::io(&tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| ExperimentError::io(path, e))
+}
+
+/// Version recorded in records and manifests.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

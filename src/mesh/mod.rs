@@ -9,7 +9,7 @@ pub mod msh;
 mod topology;
 pub mod vtu;
 
-pub use load::load;
+pub use load::{Source, load, source};
 
 pub use error::{MeshError, ReadError};
 pub use topology::Topology;
@@ -113,4 +113,14 @@ pub struct Recombined {
     pub quad_eta: Vec<f64>,
     /// Indices (into `Mesh::triangles`) of the triangles left unrecombined.
     pub leftover: Vec<u32>,
+}
+
+impl Recombined {
+    /// Nothing recombined: every triangle of `mesh` left over (to write a plain mesh).
+    pub fn unrecombined(mesh: &Mesh) -> Recombined {
+        Recombined {
+            leftover: (0..mesh.num_triangles() as u32).collect(),
+            ..Recombined::default()
+        }
+    }
 }

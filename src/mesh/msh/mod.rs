@@ -1,1 +1,106 @@
-//! Gmsh MSH 2.2 and 4.1 readers (ASCII and binary) and the MSH 4.1 ASCII writer.
+//! Gmsh MSH files: readers for versions 2.2 and 4.1, ASCII and binary, and the MSH 4.1 ASCII
+//! writer.
+//!
+//! The parser is hand-written (the `mshio` crate reads 4.1 only and reports errors without
+//! lines): one pass over the bytes, no allocation per line, node tags mapped to dense indices
+//! (a vector when tags are compact, a hash map when they are sparse). Triangles (type 2) and
+//! quads (type 3) are read with their element tag and geometric entity (surface) tag; points,
+//! lines and other element types are counted in [`MshFile::ignored_elements`] and skipped.
+//! Binary files must be little-endian (checked with the format's int `1` marker) with 8-byte
+//! `size_t`.
+//!
+//! Errors name the file and the line (ASCII, [`ReadError::Syntax`]) or the byte offset (inside
+//! binary data: [`ReadError::Io`] of kind `InvalidData` whose message starts with
+//! `byte offset N:`). Content errors found by [`Mesh::new`] come back as [`ReadError::Mesh`]
+//! with the file's node and element tags.
+
+mod read;
+mod write;
+
+use super::{Mesh, MeshData, ReadError, Recombined};
+use std::fmt;
+use std::path::Path;
+
+pub(crate) use write::check_recombined;
+pub use write::write_to;
+
+/// MSH format version of a file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MshVersion {
+    /// Version 2.2 (also read: 2.0 and 2.1, which share its layout).
+    V22,
+    /// Version 4.1.
+    V41,
+}
+
+impl fmt::Display for MshVersion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            MshVersion::V22 => "2.2",
+            MshVersion::V41 => "4.1",
+        })
+    }
+}
+
+/// A parsed MSH file before validation: its content and what the format was.
+#[derive(Debug, Clone)]
+pub struct MshFile {
+    /// Nodes, triangles and quads with the file's tags.
+    pub data: MeshData,
+    /// Format version.
+    pub version: MshVersion,
+    /// Binary (true) or ASCII.
+    pub binary: bool,
+    /// Elements of other types (points, lines, volumes, high order) that were skipped.
+    pub ignored_elements: usize,
+}
+
+impl MshFile {
+    /// Validates the content into a [`Mesh`] (see [`Mesh::new`]); errors name `path`.
+    pub fn into_mesh(self, path: &Path) -> Result<Mesh, ReadError> {
+        Mesh::new(self.data).map_err(|source| ReadError::Mesh {
+            path: path.to_path_buf(),
+            source,
+        })
+    }
+}
+
+/// True when `bytes` look like a MSH file (they start with `$MeshFormat`).
+pub fn is_msh(bytes: &[u8]) -> bool {
+    read::looks_like_msh(bytes)
+}
+
+/// Parses MSH bytes (any supported version and type) without validating the content.
+/// `path` names the source in errors.
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
+    read::parse(path, bytes)
+}
+
+/// Reads and validates a MSH file.
+pub fn read(path: &Path) -> Result<Mesh, ReadError> {
+    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(path, &bytes)?.into_mesh(path)
+}
+
+/// Reads and validates MSH content held in memory; `name` stands for the file in errors.
+pub fn read_bytes(name: &str, bytes: &[u8]) -> Result<Mesh, ReadError> {
+    let path = Path::new(name);
+    parse(path, bytes)?.into_mesh(path)
+}
+
+/// Writes `mesh` recombined as `rec` to `path` as MSH 4.1 ASCII: per surface entity, one block
+/// of quads (recombined and input quads, type 3) and one of leftover triangles (type 2), with
+/// `$Entities` so that Gmsh opens it. Node tags are the mesh's; elements are numbered from 1.
+pub fn write(path: &Path, mesh: &Mesh, rec: &Recombined) -> Result<(), ReadError> {
+    let io = |source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = std::fs::File::create(path).map_err(io)?;
+    let mut w = std::io::BufWriter::new(file);
+    write_to(&mut w, mesh, rec).map_err(io)?;
+    std::io::Write::flush(&mut w).map_err(io)
+}

@@ -1,0 +1,364 @@
+//! Runs a planned sweep into a results directory, whatever does the runs: checks the
+//! directory (fresh, or resumed with the same configuration), skips recorded runs, executes the
+//! rest, appends their records, and writes the summary.
+
+use std::collections::{BTreeMap, HashSet};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use super::ExperimentError;
+use super::exec::{Outcome, WorkerFactory, execute};
+use super::manifest::{MANIFEST_FILE, Manifest};
+use super::plan::{Job, execution_order, plan, shard};
+use super::progress::{Progress, ProgressMode};
+use super::record::{RunKey, RunRecord};
+use super::store::{self, RUNS_FILE, RunLog};
+use super::summary;
+use crate::stats::describe::effective_branching_factor;
+
+/// Options of one execution of a sweep.
+#[derive(Debug, Clone)]
+pub struct EngineOptions {
+    /// Results directory (created if missing).
+    pub dir: PathBuf,
+    /// Continue a sweep already in `dir`.
+    pub resume: bool,
+    /// Worker threads.
+    pub threads: usize,
+    /// Progress display.
+    pub progress: ProgressMode,
+}
+
+/// What an execution did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct EngineReport {
+    /// Runs in this directory's share of the run list.
+    pub planned: usize,
+    /// Runs found already recorded (resume).
+    pub already: usize,
+    /// Runs done now.
+    pub done_now: usize,
+    /// Whether a torn last line was found and redone.
+    pub torn: bool,
+    /// Whether the cancel flag stopped the sweep early.
+    pub cancelled: bool,
+}
+
+impl EngineReport {
+    /// Whether every planned run is recorded.
+    pub fn complete(&self) -> bool {
+        self.already + self.done_now == self.planned
+    }
+}
+
+/// Builds the record of a finished job.
+pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
+    let mesh = &manifest.spec.meshes[job.mesh];
+    let optimum = manifest.optimum.get(job.mesh).map(|o| o.quality);
+    let recombined_pct = if mesh.triangles == 0 {
+        0.0
+    } else {
+        100.0 * 2.0 * out.quads as f64 / mesh.triangles as f64
+    };
+    // A tree of horizon h expands the nodes at depths 0..h-1: 1 + b + ... + b^(h-1) per
+    // decision. Solve for b (the nodes below the root: b + ... + b^(h-1) = N - 1). A tree of
+    // horizon 1 expands only its root, whatever its width: no branching factor.
+    let branching_factor = match job.horizon {
+        Some(h) if h >= 2 && out.decisions > 0 => effective_branching_factor(
+            out.nodes_expanded as f64 / out.decisions as f64 - 1.0,
+            h - 1,
+        ),
+        _ => None,
+    };
+    RunRecord {
+        mesh: mesh.name.clone(),
+        mesh_hash: mesh.hash.clone(),
+        triangles: mesh.triangles,
+        algo: job.algo.clone(),
+        horizon: job.horizon,
+        seed: job.seed,
+        run: job.run,
+        quads: out.quads,
+        triangles_left: out.triangles_left,
+        recombined_pct,
+        quality: out.quality,
+        quality_pct: optimum
+            .filter(|&o| o > 0.0)
+            .map(|o| 100.0 * out.quality / o),
+        time_s: out.time_s,
+        nodes_expanded: out.nodes_expanded,
+        decisions: out.decisions,
+        branching_factor,
+        backend: manifest.backend.clone(),
+        version: manifest.version.clone(),
+    }
+}
+
+/// Checks that `records` are runs of `jobs` (same keys and seeds), each at most once.
+pub(crate) fn check_records(
+    path: &Path,
+    manifest: &Manifest,
+    jobs: &[Job],
+    records: &[RunRecord],
+) -> Result<HashSet<RunKey>, ExperimentError> {
+    let planned: BTreeMap<RunKey, &Job> = jobs.iter().map(|j| (j.key(&manifest.spec), j)).collect();
+    let mut seen = HashSet::new();
+    for r in records {
+        let key = r.key();
+        let Some(job) = planned.get(&key) else {
+            return Err(ExperimentError::Mismatch {
+                dir: path.to_path_buf(),
+                message: format!("run {key} is not part of this sweep (or of this shard)"),
+            });
+        };
+        let mesh = &manifest.spec.meshes[job.mesh];
+        if r.seed != job.seed || r.mesh_hash != mesh.hash {
+            return Err(ExperimentError::Mismatch {
+                dir: path.to_path_buf(),
+                message: format!("run {key} has another seed or mesh hash than this sweep derives"),
+            });
+        }
+        if !seen.insert(key.clone()) {
+            return Err(ExperimentError::Corrupt {
+                path: path.join(RUNS_FILE),
+                message: format!("run {key} is recorded twice"),
+            });
+        }
+    }
+    Ok(seen)
+}
+
+/// Runs the sweep described by `manifest` (its spec and shard) into `opts.dir`.
+///
+/// A fresh directory must not hold runs yet; with `resume`, its manifest must describe the
+/// same configuration, shard included, and its recorded runs are kept and skipped. Every
+/// finished run is appended and flushed at once. The summary is written at the end, also
+/// after a cancellation (of what was finished).
+pub fn run(
+    manifest: &Manifest,
+    factory: &dyn WorkerFactory,
+    opts: &EngineOptions,
+    cancel: &AtomicBool,
+) -> Result<EngineReport, ExperimentError> {
+    let dir = &opts.dir;
+    std::fs::create_dir_all(dir).map_err(|e| ExperimentError::io(dir, e))?;
+    let runs_path = dir.join(RUNS_FILE);
+    let loaded = store::read(&runs_path)?;
+    if dir.join(MANIFEST_FILE).exists() {
+        let old = Manifest::read(dir)?;
+        if opts.resume {
+            let why = manifest.incompatibility(&old).or_else(|| {
+                (old.shard != manifest.shard).then(|| {
+                    let s = |s: Option<super::manifest::Shard>| {
+                        s.map_or("the whole run list".to_string(), |s| format!("shard {s}"))
+                    };
+                    format!("{} vs {}", s(manifest.shard), s(old.shard))
+                })
+            });
+            if let Some(message) = why {
+                return Err(ExperimentError::Mismatch {
+                    dir: dir.clone(),
+                    message,
+                });
+            }
+        } else if !loaded.records.is_empty() || loaded.torn_bytes > 0 {
+            return Err(ExperimentError::AlreadyExists {
+                dir: dir.clone(),
+                records: loaded.records.len(),
+            });
+        }
+    } else if !loaded.records.is_empty() || loaded.torn_bytes > 0 {
+        return Err(ExperimentError::Corrupt {
+            path: runs_path,
+            message: format!("{} exists without {MANIFEST_FILE}", RUNS_FILE),
+        });
+    }
+    manifest.write(dir)?;
+
+    let jobs = shard(plan(&manifest.spec), manifest.shard);
+    let done = check_records(dir, manifest, &jobs, &loaded.records)?;
+    let mut todo: Vec<Job> = jobs
+        .iter()
+        .filter(|j| !done.contains(&j.key(&manifest.spec)))
+        .cloned()
+        .collect();
+    execution_order(&mut todo);
+
+    let mut log = RunLog::open_for_append(&runs_path, loaded.valid_len)?;
+    let mut progress = Progress::new(opts.progress, todo.len() as u64);
+    if !done.is_empty() && opts.progress != ProgressMode::Quiet {
+        eprintln!(
+            "sweep: resuming: {} of {} runs already recorded{}",
+            done.len(),
+            jobs.len(),
+            if loaded.torn_bytes > 0 {
+                " (a torn last line was dropped and will be redone)"
+            } else {
+                ""
+            }
+        );
+    }
+    let result = execute(&todo, opts.threads, factory, cancel, &mut |job, out| {
+        log.append(&make_record(manifest, job, out))?;
+        progress.inc();
+        Ok(())
+    });
+    progress.finish();
+    let executed = result?;
+    log.sync()?;
+    drop(log);
+
+    let all = store::read(&runs_path)?;
+    summary::write(dir, &all.records)?;
+    Ok(EngineReport {
+        planned: jobs.len(),
+        already: done.len(),
+        done_now: executed.finished,
+        torn: loaded.torn_bytes > 0,
+        cancelled: executed.cancelled,
+    })
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::experiment::exec::tests::FakeFactory;
+    use crate::experiment::manifest::{Machine, OptimumEntry, Shard};
+
+    pub(crate) fn manifest(shard: Option<Shard>) -> Manifest {
+        let spec = crate::experiment::plan::tests::spec();
+        Manifest {
+            version: crate::experiment::VERSION.into(),
+            optimum: spec
+                .meshes
+                .iter()
+                .map(|m| OptimumEntry {
+                    mesh: m.name.clone(),
+                    mesh_hash: m.hash.clone(),
+                    eta_hash: "e".into(),
+                    quality: 20.0,
+                    quads: 5,
+                    triangles_left: 0,
+                    time_s: 0.0,
+                })
+                .collect(),
+            spec,
+            backend: "fake".into(),
+            backend_requested: "cpu".into(),
+            shard,
+            threads: 1,
+            machine: Machine::current(),
+            merged_from: vec![],
+        }
+    }
+
+    pub(crate) fn opts(dir: &Path, threads: usize, resume: bool) -> EngineOptions {
+        EngineOptions {
+            dir: dir.to_path_buf(),
+            resume,
+            threads,
+            progress: ProgressMode::Quiet,
+        }
+    }
+
+    fn sorted(dir: &Path) -> Vec<RunRecord> {
+        let mut r = store::read(&dir.join(RUNS_FILE)).unwrap().records;
+        r.sort_by_key(|r| r.key());
+        r
+    }
+
+    const OK: FakeFactory = FakeFactory { fail_on_run: None };
+
+    #[test]
+    fn threads_and_resume_give_the_same_records() {
+        let tmp = tempfile::tempdir().unwrap();
+        let m = manifest(None);
+        let no = AtomicBool::new(false);
+        let a = tmp.path().join("a");
+        let rep = run(&m, &OK, &opts(&a, 1, false), &no).unwrap();
+        assert!(rep.complete() && rep.done_now == 40 && rep.already == 0);
+        let b = tmp.path().join("b");
+        run(&m, &OK, &opts(&b, 3, false), &no).unwrap();
+        assert_eq!(sorted(&a), sorted(&b));
+        assert!(b.join("summary.csv").exists() && b.join("summary.json").exists());
+
+        // Resume after a torn line: cut the file in the middle of its 10th line.
+        let text = std::fs::read(b.join(RUNS_FILE)).unwrap();
+        let cut = text
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| **c == b'\n')
+            .nth(8)
+            .unwrap()
+            .0
+            + 15;
+        std::fs::write(b.join(RUNS_FILE), &text[..cut]).unwrap();
+        let rep = run(&m, &OK, &opts(&b, 2, true), &no).unwrap();
+        assert_eq!((rep.already, rep.done_now, rep.torn), (9, 31, true));
+        assert_eq!(sorted(&a), sorted(&b));
+        let lines = std::fs::read_to_string(b.join(RUNS_FILE)).unwrap();
+        assert_eq!(lines.lines().count(), 40);
+
+        // Resuming a complete directory does nothing.
+        let rep = run(&m, &OK, &opts(&b, 2, true), &no).unwrap();
+        assert_eq!((rep.already, rep.done_now), (40, 0));
+    }
+
+    #[test]
+    fn fresh_run_refuses_a_used_directory_and_resume_refuses_another_config() {
+        let tmp = tempfile::tempdir().unwrap();
+        let m = manifest(None);
+        let no = AtomicBool::new(false);
+        run(&m, &OK, &opts(tmp.path(), 1, false), &no).unwrap();
+        let err = run(&m, &OK, &opts(tmp.path(), 1, false), &no).unwrap_err();
+        assert!(
+            matches!(err, ExperimentError::AlreadyExists { records: 40, .. }),
+            "{err}"
+        );
+        let mut other = m.clone();
+        other.spec.runs = 6;
+        let err = run(&other, &OK, &opts(tmp.path(), 1, true), &no).unwrap_err();
+        assert!(err.to_string().contains("runs 6 vs 5"), "{err}");
+        let sharded = manifest(Some(Shard { index: 1, count: 2 }));
+        let err = run(&sharded, &OK, &opts(tmp.path(), 1, true), &no).unwrap_err();
+        assert!(
+            err.to_string().contains("shard 1/2 vs the whole run list"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn cancelled_sweep_keeps_what_finished_and_resumes() {
+        let tmp = tempfile::tempdir().unwrap();
+        let m = manifest(None);
+        let yes = AtomicBool::new(true);
+        let rep = run(&m, &OK, &opts(tmp.path(), 2, false), &yes).unwrap();
+        assert!(rep.cancelled && rep.done_now == 0 && !rep.complete());
+        let no = AtomicBool::new(false);
+        let rep = run(&m, &OK, &opts(tmp.path(), 2, true), &no).unwrap();
+        assert!(rep.complete() && !rep.cancelled);
+    }
+
+    #[test]
+    fn records_carry_optimum_percent_and_branching() {
+        let m = manifest(None);
+        let job = plan(&m.spec)
+            .into_iter()
+            .find(|j| j.horizon == Some(2))
+            .unwrap();
+        let out = Outcome {
+            quads: 4,
+            triangles_left: 2,
+            quality: 15.0,
+            nodes_expanded: 60,
+            decisions: 10,
+            time_s: 0.5,
+        };
+        let r = make_record(&m, &job, out);
+        assert_eq!(r.quality_pct, Some(75.0));
+        assert_eq!(r.recombined_pct, 80.0);
+        // 6 nodes expanded per decision at h = 2: 1 + b = 6 -> b = 5.
+        assert!((r.branching_factor.unwrap() - 5.0).abs() < 1e-9);
+        assert_eq!(r.seed, job.seed);
+    }
+}

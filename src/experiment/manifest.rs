@@ -1,0 +1,251 @@
+//! `manifest.json`: what a results directory was made from and on what.
+//!
+//! The [`SweepSpec`] part decides which runs exist and what their seeds are; two directories
+//! can be merged only when their specs (and backends and versions) are equal. The machine and
+//! the shard say where each part ran.
+
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+use super::ExperimentError;
+
+/// File name of the manifest in a results directory.
+pub const MANIFEST_FILE: &str = "manifest.json";
+
+/// The manifest of a results directory.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// quadrecomb version that wrote the directory.
+    pub version: String,
+    /// The sweep configuration: meshes, algorithms, horizons, runs, base seed.
+    pub spec: SweepSpec,
+    /// Name of the evaluator that computed eta for every mesh.
+    pub backend: String,
+    /// The backend asked for on the command line ("auto", "gpu" or "cpu").
+    pub backend_requested: String,
+    /// Optimum (exact maximum-weight matching) per mesh, in the order of `spec.meshes`.
+    pub optimum: Vec<OptimumEntry>,
+    /// Which slice of the run list this directory holds; `None` for the whole list.
+    pub shard: Option<Shard>,
+    /// Worker threads used.
+    pub threads: usize,
+    /// The machine this directory's runs ran on.
+    pub machine: Machine,
+    /// For a merged directory: the shards it was merged from, with their machines.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub merged_from: Vec<MergedPart>,
+}
+
+/// The configuration that decides the run list and the seeds.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SweepSpec {
+    /// Meshes, in order.
+    pub meshes: Vec<MeshEntry>,
+    /// Algorithm names, in order ("selective", "greedy", ...).
+    pub algos: Vec<String>,
+    /// Horizons for `uniform` and `selective`.
+    pub horizons: Vec<u32>,
+    /// Runs per (mesh, tree algorithm, horizon).
+    pub runs: u32,
+    /// Runs per mesh of `greedy` and `greedy-nocrit` (their only randomness is tie-breaking).
+    pub baseline_runs: u32,
+    /// Base seed; every run's seed is derived from it.
+    pub seed: u64,
+}
+
+/// One mesh of a sweep.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MeshEntry {
+    /// Name used in records (built-in name or file stem).
+    pub name: String,
+    /// What was given on the command line (built-in name or path).
+    pub source: String,
+    /// blake3 hex digest of the mesh's canonical content.
+    pub hash: String,
+    /// Number of triangles.
+    pub triangles: usize,
+}
+
+/// The exact optimum of one mesh, with the eta it was computed from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OptimumEntry {
+    /// Mesh name.
+    pub mesh: String,
+    /// Mesh hash.
+    pub mesh_hash: String,
+    /// blake3 hex digest of the eta table (f64 bits) the optimum and the searches used.
+    pub eta_hash: String,
+    /// Sum of eta over the optimum's quads.
+    pub quality: f64,
+    /// Quads of the optimum.
+    pub quads: usize,
+    /// Triangles the optimum leaves.
+    pub triangles_left: usize,
+    /// Seconds the matching took when it was computed (it may come from the cache since).
+    pub time_s: f64,
+}
+
+/// The I-th (1-based) of N disjoint slices of a run list.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Shard {
+    /// Slice index, 1..=count.
+    pub index: u32,
+    /// Number of slices.
+    pub count: u32,
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+
+    /// Parses "I/N" with 1 <= I <= N.
+    fn from_str(s: &str) -> Result<Shard, String> {
+        let err = || format!("bad shard {s:?}: expected I/N with 1 <= I <= N, e.g. 2/8");
+        let (i, n) = s.split_once('/').ok_or_else(err)?;
+        let index: u32 = i.trim().parse().map_err(|_| err())?;
+        let count: u32 = n.trim().parse().map_err(|_| err())?;
+        if count == 0 || index == 0 || index > count {
+            return Err(err());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+/// Where a part of a merged directory ran.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MergedPart {
+    /// The directory merged.
+    pub dir: String,
+    /// Its shard, if any.
+    pub shard: Option<Shard>,
+    /// Its machine.
+    pub machine: Machine,
+    /// Records taken from it.
+    pub records: usize,
+}
+
+/// The machine a sweep ran on.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Machine {
+    /// CPU model name (from /proc/cpuinfo where available).
+    pub cpu: String,
+    /// Logical cores available to the process.
+    pub cores: usize,
+    /// Operating system (family, distribution and kernel where available).
+    pub os: String,
+    /// Host name, where available.
+    pub host: String,
+}
+
+impl Machine {
+    /// Describes the machine this process runs on.
+    pub fn current() -> Machine {
+        let cpu = std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|s| {
+                s.lines()
+                    .find(|l| l.starts_with("model name"))
+                    .and_then(|l| l.split_once(':'))
+                    .map(|(_, v)| v.trim().to_string())
+            })
+            .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let mut os = std::env::consts::OS.to_string();
+        if let Some(pretty) = std::fs::read_to_string("/etc/os-release")
+            .ok()
+            .and_then(|s| {
+                s.lines()
+                    .find_map(|l| l.strip_prefix("PRETTY_NAME="))
+                    .map(|v| v.trim_matches('"').to_string())
+            })
+        {
+            os = format!("{os} ({pretty})");
+        }
+        if let Ok(kernel) = std::fs::read_to_string("/proc/sys/kernel/osrelease") {
+            os = format!("{os}, kernel {}", kernel.trim());
+        }
+        let host = std::fs::read_to_string("/proc/sys/kernel/hostname")
+            .map(|s| s.trim().to_string())
+            .unwrap_or_default();
+        Machine {
+            cpu,
+            cores,
+            os,
+            host,
+        }
+    }
+}
+
+impl Manifest {
+    /// Reads `dir/manifest.json`.
+    pub fn read(dir: &Path) -> Result<Manifest, ExperimentError> {
+        let path = dir.join(MANIFEST_FILE);
+        let text = std::fs::read_to_string(&path).map_err(|e| ExperimentError::io(&path, e))?;
+        serde_json::from_str(&text).map_err(|e| ExperimentError::Corrupt {
+            path: path.clone(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Writes `dir/manifest.json` (through a temporary file, so a kill never leaves half of it).
+    pub fn write(&self, dir: &Path) -> Result<(), ExperimentError> {
+        let text = serde_json::to_string_pretty(self).expect("a Manifest always serializes");
+        super::write_atomic(&dir.join(MANIFEST_FILE), format!("{text}\n").as_bytes())
+    }
+
+    /// Why `other` cannot be combined with `self` (resumed into, or merged), if it cannot:
+    /// a different spec, backend or version.
+    pub fn incompatibility(&self, other: &Manifest) -> Option<String> {
+        if self.version != other.version {
+            return Some(format!(
+                "quadrecomb version {} vs {}",
+                self.version, other.version
+            ));
+        }
+        if self.backend != other.backend {
+            return Some(format!(
+                "eta backend {:?} vs {:?} (qualities may differ in the last bits)",
+                self.backend, other.backend
+            ));
+        }
+        spec_difference(&self.spec, &other.spec)
+    }
+}
+
+/// The first difference between two specs, in words.
+pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
+    if a.meshes != b.meshes {
+        let names = |s: &SweepSpec| {
+            s.meshes
+                .iter()
+                .map(|m| format!("{} ({})", m.name, &m.hash[..m.hash.len().min(12)]))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        return Some(format!("meshes [{}] vs [{}]", names(a), names(b)));
+    }
+    if a.algos != b.algos {
+        return Some(format!("algorithms {:?} vs {:?}", a.algos, b.algos));
+    }
+    if a.horizons != b.horizons {
+        return Some(format!("horizons {:?} vs {:?}", a.horizons, b.horizons));
+    }
+    if a.runs != b.runs {
+        return Some(format!("runs {} vs {}", a.runs, b.runs));
+    }
+    if a.baseline_runs != b.baseline_runs {
+        return Some(format!(
+            "baseline runs {} vs {}",
+            a.baseline_runs, b.baseline_runs
+        ));
+    }
+    if a.seed != b.seed {
+        return Some(format!("seed {} vs {}", a.seed, b.seed));
+    }
+    None
+}

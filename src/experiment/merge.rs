@@ -1,0 +1,229 @@
+//! Merging the results directories of shards (or any disjoint parts) of one sweep.
+//!
+//! The parts must have the same configuration (spec, backend, version); together they must hold
+//! every run of the run list exactly once. The merged directory gets the runs in canonical
+//! order, a manifest naming the parts and their machines, and a fresh summary.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use super::ExperimentError;
+use super::engine::check_records;
+use super::manifest::{Manifest, MergedPart};
+use super::plan::plan;
+use super::record::{RunKey, RunRecord};
+use super::store::{self, RUNS_FILE, RunLog};
+use super::summary;
+
+/// What a merge wrote.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Merged {
+    /// Records written.
+    pub records: usize,
+    /// Parts merged.
+    pub parts: usize,
+}
+
+/// Merges `parts` into `out` (which must not hold runs already).
+pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
+    if parts.is_empty() {
+        return Err(ExperimentError::Merge("no directories to merge".into()));
+    }
+    let mut manifests = Vec::new();
+    for p in parts {
+        manifests.push(Manifest::read(p)?);
+    }
+    let first = &manifests[0];
+    for (p, m) in parts.iter().zip(&manifests).skip(1) {
+        if let Some(why) = first.incompatibility(m) {
+            return Err(ExperimentError::Merge(format!(
+                "{} and {} are not parts of the same sweep: {why}",
+                parts[0].display(),
+                p.display()
+            )));
+        }
+    }
+    let jobs = plan(&first.spec);
+    let mut by_key: BTreeMap<RunKey, (RunRecord, usize)> = BTreeMap::new();
+    let mut merged_from = Vec::new();
+    for (i, (p, m)) in parts.iter().zip(&manifests).enumerate() {
+        let loaded = store::read(&p.join(RUNS_FILE))?;
+        if loaded.torn_bytes > 0 {
+            return Err(ExperimentError::Merge(format!(
+                "{} ends with a torn line (the sweep was interrupted): run `quadrecomb sweep --resume` there first",
+                p.join(RUNS_FILE).display()
+            )));
+        }
+        // Every record must be a run of the whole list with the right seed (a shard's records
+        // are runs of the whole list too).
+        check_records(p, m, &jobs, &loaded.records)?;
+        for r in &loaded.records {
+            if let Some((_, j)) = by_key.get(&r.key()) {
+                return Err(ExperimentError::Merge(format!(
+                    "run {} is in both {} and {}",
+                    r.key(),
+                    parts[*j].display(),
+                    p.display()
+                )));
+            }
+            by_key.insert(r.key(), (r.clone(), i));
+        }
+        merged_from.push(MergedPart {
+            dir: p.display().to_string(),
+            shard: m.shard,
+            machine: m.machine.clone(),
+            records: loaded.records.len(),
+        });
+    }
+    let missing: Vec<RunKey> = jobs
+        .iter()
+        .map(|j| j.key(&first.spec))
+        .filter(|k| !by_key.contains_key(k))
+        .collect();
+    if !missing.is_empty() {
+        let list: Vec<String> = missing.iter().take(5).map(|k| k.to_string()).collect();
+        return Err(ExperimentError::Merge(format!(
+            "{} of {} runs are missing (a shard not given, not finished, or run with another --shard count?), e.g.: {}",
+            missing.len(),
+            jobs.len(),
+            list.join("; ")
+        )));
+    }
+
+    std::fs::create_dir_all(out).map_err(|e| ExperimentError::io(out, e))?;
+    let out_runs = out.join(RUNS_FILE);
+    let existing = store::read(&out_runs)?;
+    if !existing.records.is_empty() || existing.torn_bytes > 0 {
+        return Err(ExperimentError::AlreadyExists {
+            dir: out.to_path_buf(),
+            records: existing.records.len(),
+        });
+    }
+    let mut manifest = first.clone();
+    manifest.shard = None;
+    manifest.threads = manifests.iter().map(|m| m.threads).max().unwrap_or(1);
+    manifest.machine = super::manifest::Machine::current();
+    manifest.merged_from = merged_from;
+    manifest.write(out)?;
+    let mut log = RunLog::create(&out_runs)?;
+    let mut records = Vec::with_capacity(jobs.len());
+    for j in &jobs {
+        let (r, _) = by_key
+            .remove(&j.key(&first.spec))
+            .expect("checked: none missing");
+        log.append(&r)?;
+        records.push(r);
+    }
+    log.sync()?;
+    summary::write(out, &records)?;
+    Ok(Merged {
+        records: records.len(),
+        parts: parts.len(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::engine::run;
+    use crate::experiment::engine::tests::{manifest, opts};
+    use crate::experiment::exec::tests::FakeFactory;
+    use crate::experiment::manifest::Shard;
+    use std::sync::atomic::AtomicBool;
+
+    const OK: FakeFactory = FakeFactory { fail_on_run: None };
+
+    fn sweep(dir: &Path, shard: Option<Shard>) {
+        run(
+            &manifest(shard),
+            &OK,
+            &opts(dir, 2, false),
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+    }
+
+    fn sorted(dir: &Path) -> Vec<RunRecord> {
+        let mut r = store::read(&dir.join(RUNS_FILE)).unwrap().records;
+        r.sort_by_key(|r| r.key());
+        r
+    }
+
+    #[test]
+    fn three_shards_merge_into_the_whole() {
+        let tmp = tempfile::tempdir().unwrap();
+        let whole = tmp.path().join("whole");
+        sweep(&whole, None);
+        let parts: Vec<PathBuf> = (1..=3)
+            .map(|i| {
+                let d = tmp.path().join(format!("s{i}"));
+                sweep(&d, Some(Shard { index: i, count: 3 }));
+                d
+            })
+            .collect();
+        let out = tmp.path().join("merged");
+        let m = merge(&parts, &out).unwrap();
+        assert_eq!(m.records, 40);
+        let a = sorted(&whole);
+        let b = sorted(&out);
+        assert_eq!(a.len(), b.len());
+        assert!(a.iter().zip(&b).all(|(x, y)| x.same_result(y)));
+        let man = Manifest::read(&out).unwrap();
+        assert_eq!(man.merged_from.len(), 3);
+        assert!(man.shard.is_none());
+        // The merged summary equals the whole sweep's except for times.
+        let sa = std::fs::read_to_string(whole.join("summary.csv")).unwrap();
+        let sb = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+        let strip = |s: &str| -> Vec<String> {
+            s.lines()
+                .filter(|l| !l.contains(",time_s,"))
+                .map(String::from)
+                .collect()
+        };
+        assert_eq!(strip(&sa), strip(&sb));
+        // Merging again into the same directory is refused.
+        assert!(matches!(
+            merge(&parts, &out),
+            Err(ExperimentError::AlreadyExists { .. })
+        ));
+    }
+
+    #[test]
+    fn merge_rejects_missing_duplicated_and_foreign_parts() {
+        let tmp = tempfile::tempdir().unwrap();
+        let s: Vec<PathBuf> = (1..=3)
+            .map(|i| {
+                let d = tmp.path().join(format!("s{i}"));
+                sweep(&d, Some(Shard { index: i, count: 3 }));
+                d
+            })
+            .collect();
+        let err = merge(&s[..2], &tmp.path().join("o1"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("runs are missing"), "{err}");
+        let dup = vec![s[0].clone(), s[1].clone(), s[2].clone(), s[0].clone()];
+        let err = merge(&dup, &tmp.path().join("o2")).unwrap_err().to_string();
+        assert!(err.contains("is in both"), "{err}");
+
+        let other = tmp.path().join("other");
+        let mut m = manifest(Some(Shard { index: 3, count: 3 }));
+        m.spec.seed += 1;
+        run(&m, &OK, &opts(&other, 1, false), &AtomicBool::new(false)).unwrap();
+        let err = merge(&[s[0].clone(), s[1].clone(), other], &tmp.path().join("o3"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("not parts of the same sweep") && err.contains("seed"),
+            "{err}"
+        );
+
+        // A torn line in a part is named.
+        let runs = s[2].join(RUNS_FILE);
+        let mut text = std::fs::read(&runs).unwrap();
+        text.truncate(text.len() - 3);
+        std::fs::write(&runs, text).unwrap();
+        let err = merge(&s, &tmp.path().join("o4")).unwrap_err().to_string();
+        assert!(err.contains("torn line"), "{err}");
+    }
+}

@@ -1,0 +1,188 @@
+//! The run list of a sweep, its sharding, and the order runs execute in.
+
+use super::manifest::{Shard, SweepSpec};
+use super::record::RunKey;
+use super::seed::derive_seed;
+
+/// Algorithms with a look-ahead horizon.
+pub fn has_horizon(algo: &str) -> bool {
+    matches!(algo, "uniform" | "selective")
+}
+
+/// One run to do.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Job {
+    /// Position of the mesh in the spec.
+    pub mesh: usize,
+    /// Algorithm name.
+    pub algo: String,
+    /// Horizon, for `uniform` and `selective`.
+    pub horizon: Option<u32>,
+    /// Run index within the configuration.
+    pub run: u32,
+    /// The derived seed.
+    pub seed: u64,
+}
+
+impl Job {
+    /// The key of the record this job makes.
+    pub fn key(&self, spec: &SweepSpec) -> RunKey {
+        RunKey {
+            mesh: spec.meshes[self.mesh].name.clone(),
+            algo: self.algo.clone(),
+            horizon: self.horizon,
+            run: self.run,
+        }
+    }
+}
+
+/// Every run of a sweep, in canonical order: by mesh, then algorithm (spec order), then
+/// horizon, then run index. `optimum` is one run per mesh; `greedy` and `greedy-nocrit` are
+/// `baseline_runs` runs; `uniform` and `selective` are `runs` runs per horizon.
+pub fn plan(spec: &SweepSpec) -> Vec<Job> {
+    let mut jobs = Vec::new();
+    for (m, mesh) in spec.meshes.iter().enumerate() {
+        for algo in &spec.algos {
+            let (horizons, runs): (Vec<Option<u32>>, u32) = match algo.as_str() {
+                "optimum" => (vec![None], 1),
+                a if has_horizon(a) => {
+                    (spec.horizons.iter().map(|&h| Some(h)).collect(), spec.runs)
+                }
+                _ => (vec![None], spec.baseline_runs),
+            };
+            for horizon in horizons {
+                for run in 0..runs {
+                    jobs.push(Job {
+                        mesh: m,
+                        algo: algo.clone(),
+                        horizon,
+                        run,
+                        seed: derive_seed(spec.seed, &mesh.hash, algo, horizon, run),
+                    });
+                }
+            }
+        }
+    }
+    jobs
+}
+
+/// The jobs of one shard: job number k (0-based, canonical order) belongs to shard
+/// `k % count + 1`. Striding spreads every configuration (and so the cost) evenly over shards.
+pub fn shard(jobs: Vec<Job>, shard: Option<Shard>) -> Vec<Job> {
+    match shard {
+        None => jobs,
+        Some(s) => jobs
+            .into_iter()
+            .enumerate()
+            .filter(|(k, _)| (*k as u64) % u64::from(s.count) == u64::from(s.index - 1))
+            .map(|(_, j)| j)
+            .collect(),
+    }
+}
+
+/// Execution order: interleaved by run index (run 0 of every configuration, then run 1, ...),
+/// with the most expensive configurations (highest horizon) first within a round. An
+/// interrupted sweep then holds about as many runs of every configuration, and the progress
+/// rate (and ETA) stays steady.
+pub fn execution_order(jobs: &mut [Job]) {
+    jobs.sort_by_key(|j| {
+        (
+            j.run,
+            std::cmp::Reverse(j.horizon.unwrap_or(0)),
+            j.mesh,
+            j.algo.clone(),
+        )
+    });
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::experiment::manifest::MeshEntry;
+
+    pub(crate) fn spec() -> SweepSpec {
+        SweepSpec {
+            meshes: vec![
+                MeshEntry {
+                    name: "a".into(),
+                    source: "a".into(),
+                    hash: "aa".into(),
+                    triangles: 10,
+                },
+                MeshEntry {
+                    name: "b".into(),
+                    source: "b.msh".into(),
+                    hash: "bb".into(),
+                    triangles: 20,
+                },
+            ],
+            algos: vec![
+                "selective".into(),
+                "greedy".into(),
+                "greedy-nocrit".into(),
+                "optimum".into(),
+            ],
+            horizons: vec![1, 2, 3],
+            runs: 5,
+            baseline_runs: 2,
+            seed: 9,
+        }
+    }
+
+    #[test]
+    fn plan_counts_and_unique_keys() {
+        let s = spec();
+        let jobs = plan(&s);
+        assert_eq!(jobs.len(), 2 * (3 * 5 + 2 + 2 + 1));
+        let keys: std::collections::BTreeSet<_> = jobs.iter().map(|j| j.key(&s)).collect();
+        assert_eq!(keys.len(), jobs.len());
+        let seeds: std::collections::BTreeSet<_> = jobs.iter().map(|j| j.seed).collect();
+        assert_eq!(seeds.len(), jobs.len());
+        assert!(
+            jobs.iter()
+                .all(|j| j.horizon.is_some() == (j.algo == "selective"))
+        );
+    }
+
+    #[test]
+    fn shards_partition_the_plan() {
+        let s = spec();
+        let all = plan(&s);
+        for n in [1u32, 2, 3, 7, 100] {
+            let mut union = Vec::new();
+            for i in 1..=n {
+                let part = shard(all.clone(), Some(Shard { index: i, count: n }));
+                let expected = all.len() / n as usize;
+                assert!(part.len() == expected || part.len() == expected + 1);
+                union.extend(part);
+            }
+            union.sort_by_key(|j| j.key(&s));
+            let mut want = all.clone();
+            want.sort_by_key(|j| j.key(&s));
+            assert_eq!(union, want, "{n} shards");
+        }
+    }
+
+    #[test]
+    fn shard_parsing() {
+        assert_eq!("2/3".parse::<Shard>(), Ok(Shard { index: 2, count: 3 }));
+        assert!("0/3".parse::<Shard>().is_err());
+        assert!("4/3".parse::<Shard>().is_err());
+        assert!("1/0".parse::<Shard>().is_err());
+        assert!("x".parse::<Shard>().is_err());
+    }
+
+    #[test]
+    fn execution_order_is_a_permutation_interleaved_by_run() {
+        let s = spec();
+        let mut jobs = plan(&s);
+        let mut sorted = jobs.clone();
+        execution_order(&mut jobs);
+        assert_eq!(jobs[0].run, 0);
+        assert_eq!(jobs[0].horizon, Some(3));
+        assert!(jobs.windows(2).all(|w| w[0].run <= w[1].run));
+        jobs.sort_by_key(|j| j.key(&s));
+        sorted.sort_by_key(|j| j.key(&s));
+        assert_eq!(jobs, sorted);
+    }
+}

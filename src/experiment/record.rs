@@ -1,0 +1,103 @@
+//! One run's result: the line format of `runs.jsonl`.
+//!
+//! Every finished run of a sweep is one [`RunRecord`], written as one JSON object on one line of
+//! `runs.jsonl` and flushed at once, so that a killed sweep loses at most the line it was writing.
+//! The field names are a stable contract read by `report` and by external tools.
+
+use serde::{Deserialize, Serialize};
+
+/// The algorithm names a record's `algo` field takes.
+pub const ALGO_NAMES: &[&str] = &["greedy-nocrit", "greedy", "uniform", "selective", "optimum"];
+
+/// The result of one run of one algorithm on one mesh.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// Name of the mesh (built-in name or file stem).
+    pub mesh: String,
+    /// blake3 hex digest of the mesh's canonical content (see [`super::mesh_hash`]).
+    pub mesh_hash: String,
+    /// Number of triangles of the input mesh.
+    pub triangles: usize,
+    /// "greedy-nocrit", "greedy", "uniform", "selective" or "optimum".
+    pub algo: String,
+    /// Look-ahead horizon of `uniform` and `selective`; `None` for the others.
+    pub horizon: Option<u32>,
+    /// The per-run seed given to the search, derived by [`super::seed::derive_seed`].
+    pub seed: u64,
+    /// Index of the run within its (mesh, algo, horizon) configuration, from 0.
+    pub run: u32,
+    /// Quads created.
+    pub quads: usize,
+    /// Triangles left unrecombined.
+    pub triangles_left: usize,
+    /// 100 * 2 * quads / triangles.
+    pub recombined_pct: f64,
+    /// Sum of eta over the quads (the paper's eq. 2).
+    pub quality: f64,
+    /// 100 * quality / optimum quality of the mesh, when the optimum is known.
+    pub quality_pct: Option<f64>,
+    /// Seconds spent in the search (or the matching, for "optimum"), excluding loading and eta.
+    pub time_s: f64,
+    /// Tree nodes expanded by the search (0 for "optimum").
+    pub nodes_expanded: u64,
+    /// Actions applied (decisions taken) by the search; quads for "optimum".
+    pub decisions: u64,
+    /// Effective branching factor of the look-ahead tree, for `uniform` and `selective` with
+    /// h >= 2: the b with 1 + b + ... + b^(h-1) = nodes_expanded / decisions (a tree of horizon
+    /// h expands the nodes of depths 0..h-1; see
+    /// [`crate::stats::describe::effective_branching_factor`]). `None` for h = 1 (only the root
+    /// is expanded, whatever its width), for the other algorithms, and without decisions.
+    pub branching_factor: Option<f64>,
+    /// Name of the evaluator that computed eta ("cpu-twin", "vulkan: llvmpipe ...", ...).
+    pub backend: String,
+    /// Version of quadrecomb that made the record.
+    pub version: String,
+}
+
+/// Identifies a run within a sweep: no two records of a results directory share a key.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct RunKey {
+    /// Mesh name.
+    pub mesh: String,
+    /// Algorithm name.
+    pub algo: String,
+    /// Horizon, for tree policies.
+    pub horizon: Option<u32>,
+    /// Run index.
+    pub run: u32,
+}
+
+impl std::fmt::Display for RunKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {}", self.mesh, self.algo)?;
+        if let Some(h) = self.horizon {
+            write!(f, " h={h}")?;
+        }
+        write!(f, " run {}", self.run)
+    }
+}
+
+impl RunRecord {
+    /// The record's key.
+    pub fn key(&self) -> RunKey {
+        RunKey {
+            mesh: self.mesh.clone(),
+            algo: self.algo.clone(),
+            horizon: self.horizon,
+            run: self.run,
+        }
+    }
+
+    /// Whether two records hold the same result: every field but `time_s` (wall-clock time
+    /// differs between any two executions) is equal.
+    pub fn same_result(&self, other: &RunRecord) -> bool {
+        let mut a = self.clone();
+        a.time_s = other.time_s;
+        a == *other
+    }
+
+    /// The record as one JSON line, without the newline.
+    pub fn to_json_line(&self) -> String {
+        serde_json::to_string(self).expect("a RunRecord always serializes")
+    }
+}

@@ -1,0 +1,195 @@
+//! `runs.jsonl`: one [`RunRecord`] per line, appended and flushed as each run finishes.
+//!
+//! A kill can leave at most one torn line: the last one, without its newline. Reading ignores
+//! it (that run is redone) and [`RunLog::open_for_append`] truncates it away before appending,
+//! so a resumed file never holds half a record. A complete line that does not parse is not a
+//! kill's doing: it is reported as corruption rather than skipped.
+
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use super::ExperimentError;
+use super::record::RunRecord;
+
+/// File name of the run log in a results directory.
+pub const RUNS_FILE: &str = "runs.jsonl";
+
+/// The records of a run log and what was found at its end.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Loaded {
+    /// Complete, parsed records, in file order.
+    pub records: Vec<RunRecord>,
+    /// Length in bytes of the complete lines (where appending resumes).
+    pub valid_len: u64,
+    /// Bytes of a torn last line (no newline), ignored; 0 if none.
+    pub torn_bytes: u64,
+}
+
+/// Reads a run log. A missing file is an empty log.
+pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(e) => return Err(ExperimentError::io(path, e)),
+    };
+    let valid_len = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let mut records = Vec::new();
+    for (n, line) in bytes[..valid_len].split(|&b| b == b'\n').enumerate() {
+        if line.iter().all(u8::is_ascii_whitespace) {
+            continue;
+        }
+        let rec: RunRecord =
+            serde_json::from_slice(line).map_err(|e| ExperimentError::Corrupt {
+                path: path.to_path_buf(),
+                message: format!("line {}: {e}", n + 1),
+            })?;
+        records.push(rec);
+    }
+    Ok(Loaded {
+        records,
+        valid_len: valid_len as u64,
+        torn_bytes: (bytes.len() - valid_len) as u64,
+    })
+}
+
+/// An open run log that appends one flushed line per record.
+#[derive(Debug)]
+pub struct RunLog {
+    path: PathBuf,
+    file: File,
+}
+
+impl RunLog {
+    /// Opens `path` for appending after its first `valid_len` bytes, truncating anything after
+    /// them (a torn last line). Creates the file if needed.
+    pub fn open_for_append(path: &Path, valid_len: u64) -> Result<RunLog, ExperimentError> {
+        let file = OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(path)
+            .map_err(|e| ExperimentError::io(path, e))?;
+        file.set_len(valid_len)
+            .map_err(|e| ExperimentError::io(path, e))?;
+        let mut log = RunLog {
+            path: path.to_path_buf(),
+            file,
+        };
+        use std::io::Seek;
+        log.file
+            .seek(std::io::SeekFrom::Start(valid_len))
+            .map_err(|e| ExperimentError::io(path, e))?;
+        Ok(log)
+    }
+
+    /// Creates (or empties) `path` for a fresh log.
+    pub fn create(path: &Path) -> Result<RunLog, ExperimentError> {
+        let file = File::create(path).map_err(|e| ExperimentError::io(path, e))?;
+        Ok(RunLog {
+            path: path.to_path_buf(),
+            file,
+        })
+    }
+
+    /// Appends one record as one line, in one write, and flushes it to the OS.
+    pub fn append(&mut self, rec: &RunRecord) -> Result<(), ExperimentError> {
+        let mut line = rec.to_json_line();
+        line.push('\n');
+        self.file
+            .write_all(line.as_bytes())
+            .and_then(|()| self.file.flush())
+            .map_err(|e| ExperimentError::io(&self.path, e))
+    }
+
+    /// Flushes the file to the disk (at the end of a sweep).
+    pub fn sync(&mut self) -> Result<(), ExperimentError> {
+        self.file
+            .sync_data()
+            .map_err(|e| ExperimentError::io(&self.path, e))
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    pub(crate) fn record(run: u32) -> RunRecord {
+        RunRecord {
+            mesh: "m".into(),
+            mesh_hash: "00".into(),
+            triangles: 100,
+            algo: "selective".into(),
+            horizon: Some(2),
+            seed: 42 + u64::from(run),
+            run,
+            quads: 48,
+            triangles_left: 4,
+            recombined_pct: 96.0,
+            quality: 40.5,
+            quality_pct: Some(97.25),
+            time_s: 0.01,
+            nodes_expanded: 300,
+            decisions: 48,
+            branching_factor: Some(1.9),
+            backend: "cpu-twin".into(),
+            version: "0.1.0".into(),
+        }
+    }
+
+    #[test]
+    fn append_then_read_round_trips() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(RUNS_FILE);
+        let mut log = RunLog::create(&path).unwrap();
+        for r in 0..3 {
+            log.append(&record(r)).unwrap();
+        }
+        let loaded = read(&path).unwrap();
+        assert_eq!(loaded.records, (0..3).map(record).collect::<Vec<_>>());
+        assert_eq!(loaded.torn_bytes, 0);
+        assert_eq!(loaded.valid_len, std::fs::metadata(&path).unwrap().len());
+    }
+
+    #[test]
+    fn torn_last_line_is_ignored_then_truncated() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(RUNS_FILE);
+        let mut log = RunLog::create(&path).unwrap();
+        log.append(&record(0)).unwrap();
+        log.append(&record(1)).unwrap();
+        drop(log);
+        let full = std::fs::read(&path).unwrap();
+        // Tear the second line in the middle.
+        let first_len = full.iter().position(|&b| b == b'\n').unwrap() + 1;
+        std::fs::write(&path, &full[..first_len + 20]).unwrap();
+        let loaded = read(&path).unwrap();
+        assert_eq!(loaded.records, vec![record(0)]);
+        assert_eq!(loaded.valid_len, first_len as u64);
+        assert_eq!(loaded.torn_bytes, 20);
+        let mut log = RunLog::open_for_append(&path, loaded.valid_len).unwrap();
+        log.append(&record(1)).unwrap();
+        drop(log);
+        assert_eq!(std::fs::read(&path).unwrap(), full);
+        assert_eq!(read(&path).unwrap().records, vec![record(0), record(1)]);
+    }
+
+    #[test]
+    fn corrupt_complete_line_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(RUNS_FILE);
+        let mut text = record(0).to_json_line();
+        text.push_str("\n{\"mesh\": 1}\n");
+        std::fs::write(&path, text).unwrap();
+        let err = read(&path).unwrap_err().to_string();
+        assert!(err.contains("line 2"), "{err}");
+    }
+
+    #[test]
+    fn missing_file_is_empty() {
+        let dir = tempfile::tempdir().unwrap();
+        let loaded = read(&dir.path().join(RUNS_FILE)).unwrap();
+        assert!(loaded.records.is_empty());
+        assert_eq!(loaded.valid_len, 0);
+    }
+}

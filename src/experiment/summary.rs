@@ -1,0 +1,244 @@
+//! `summary.json` and `summary.csv`: statistics per (mesh, algorithm, horizon) and the growth
+//! of time with horizon per (mesh, algorithm).
+//!
+//! summary.csv is long-format: one row per (mesh, algo, horizon, metric) with the columns
+//! `mesh,algo,horizon,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers`
+//! (horizon empty for algorithms without one). Metrics: `quality_pct`, `recombined_pct`,
+//! `time_s`, `nodes_expanded`, `branching_factor` (the last only where defined).
+//! summary.json holds the same groups with the outlier values, and the growth fits.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::ExperimentError;
+use super::record::RunRecord;
+use crate::stats::describe::{BoxStats, Growth, growth_fit};
+
+/// File names in a results directory.
+pub const SUMMARY_JSON: &str = "summary.json";
+/// See [`SUMMARY_JSON`].
+pub const SUMMARY_CSV: &str = "summary.csv";
+
+/// Metrics summarised, in CSV order.
+pub const METRICS: &[&str] = &[
+    "quality_pct",
+    "recombined_pct",
+    "time_s",
+    "nodes_expanded",
+    "branching_factor",
+];
+
+/// Statistics of one (mesh, algo, horizon) configuration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Group {
+    /// Mesh name.
+    pub mesh: String,
+    /// Algorithm name.
+    pub algo: String,
+    /// Horizon, for tree policies.
+    pub horizon: Option<u32>,
+    /// Runs in the group.
+    pub n: usize,
+    /// Quality as % of the optimum (`None` when no run knows the optimum).
+    pub quality_pct: Option<BoxStats>,
+    /// Recombined triangles, %.
+    pub recombined_pct: Option<BoxStats>,
+    /// Search time, s.
+    pub time_s: Option<BoxStats>,
+    /// Tree nodes expanded per run.
+    pub nodes_expanded: Option<BoxStats>,
+    /// Effective branching factor per run (where defined).
+    pub branching_factor: Option<BoxStats>,
+    /// Mean of the runs' effective branching factors.
+    pub mean_branching_factor: Option<f64>,
+}
+
+/// Growth of time with horizon for one (mesh, algo).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GrowthEntry {
+    /// Mesh name.
+    pub mesh: String,
+    /// Algorithm name.
+    pub algo: String,
+    /// Fit of log10(median time) against h over every horizon.
+    pub all: Option<Growth>,
+    /// The same over the upper half of the horizons (h >= the median horizon), where the
+    /// paper reads its asymptotic alpha.
+    pub upper: Option<Growth>,
+}
+
+/// The whole summary.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Configurations, sorted by mesh, algorithm, horizon.
+    pub groups: Vec<Group>,
+    /// Growth fits for algorithms with a horizon.
+    pub growth: Vec<GrowthEntry>,
+}
+
+/// Computes the summary of a set of records.
+pub fn summarize(records: &[RunRecord]) -> Summary {
+    let mut by: BTreeMap<(String, String, Option<u32>), Vec<&RunRecord>> = BTreeMap::new();
+    for r in records {
+        by.entry((r.mesh.clone(), r.algo.clone(), r.horizon))
+            .or_default()
+            .push(r);
+    }
+    let groups: Vec<Group> = by
+        .into_iter()
+        .map(|((mesh, algo, horizon), rs)| {
+            let col = |f: &dyn Fn(&RunRecord) -> Option<f64>| -> Vec<f64> {
+                rs.iter()
+                    .filter_map(|r| f(r))
+                    .filter(|x| x.is_finite())
+                    .collect()
+            };
+            let bf = col(&|r| r.branching_factor);
+            Group {
+                mesh,
+                algo,
+                horizon,
+                n: rs.len(),
+                quality_pct: BoxStats::of(&col(&|r| r.quality_pct)),
+                recombined_pct: BoxStats::of(&col(&|r| Some(r.recombined_pct))),
+                time_s: BoxStats::of(&col(&|r| Some(r.time_s))),
+                nodes_expanded: BoxStats::of(&col(&|r| Some(r.nodes_expanded as f64))),
+                mean_branching_factor: (!bf.is_empty()).then(|| crate::stats::describe::mean(&bf)),
+                branching_factor: BoxStats::of(&bf),
+            }
+        })
+        .collect();
+    let mut curves: BTreeMap<(String, String), Vec<(u32, f64)>> = BTreeMap::new();
+    for g in &groups {
+        if let (Some(h), Some(t)) = (g.horizon, &g.time_s) {
+            curves
+                .entry((g.mesh.clone(), g.algo.clone()))
+                .or_default()
+                .push((h, t.median));
+        }
+    }
+    let growth = curves
+        .into_iter()
+        .map(|((mesh, algo), pts)| {
+            let hs: Vec<f64> = pts.iter().map(|p| f64::from(p.0)).collect();
+            let h_mid = crate::stats::describe::median(&hs);
+            let upper: Vec<(u32, f64)> = pts
+                .iter()
+                .copied()
+                .filter(|p| f64::from(p.0) >= h_mid)
+                .collect();
+            GrowthEntry {
+                mesh,
+                algo,
+                all: growth_fit(&pts),
+                upper: growth_fit(&upper),
+            }
+        })
+        .collect();
+    Summary { groups, growth }
+}
+
+impl Group {
+    fn metric(&self, name: &str) -> Option<&BoxStats> {
+        match name {
+            "quality_pct" => self.quality_pct.as_ref(),
+            "recombined_pct" => self.recombined_pct.as_ref(),
+            "time_s" => self.time_s.as_ref(),
+            "nodes_expanded" => self.nodes_expanded.as_ref(),
+            "branching_factor" => self.branching_factor.as_ref(),
+            _ => None,
+        }
+    }
+}
+
+/// The CSV text of a summary (see the module docs for the columns).
+pub fn to_csv(summary: &Summary) -> String {
+    let mut out = String::from(
+        "mesh,algo,horizon,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers\n",
+    );
+    for g in &summary.groups {
+        for &metric in METRICS {
+            if let Some(b) = g.metric(metric) {
+                let h = g.horizon.map(|h| h.to_string()).unwrap_or_default();
+                out.push_str(&format!(
+                    "{},{},{h},{metric},{},{},{},{},{},{},{},{},{},{},{}\n",
+                    csv_field(&g.mesh),
+                    g.algo,
+                    b.n,
+                    b.mean,
+                    b.sd,
+                    b.min,
+                    b.whisker_low,
+                    b.q1,
+                    b.median,
+                    b.q3,
+                    b.whisker_high,
+                    b.max,
+                    b.outliers.len()
+                ));
+            }
+        }
+    }
+    out
+}
+
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// Writes summary.json and summary.csv into `dir`.
+pub fn write(dir: &Path, records: &[RunRecord]) -> Result<Summary, ExperimentError> {
+    let summary = summarize(records);
+    let json = serde_json::to_string_pretty(&summary).expect("a Summary always serializes");
+    super::write_atomic(&dir.join(SUMMARY_JSON), format!("{json}\n").as_bytes())?;
+    super::write_atomic(&dir.join(SUMMARY_CSV), to_csv(&summary).as_bytes())?;
+    Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::store::tests::record;
+
+    #[test]
+    fn groups_and_growth() {
+        let mut recs = Vec::new();
+        for h in 1..=4u32 {
+            for run in 0..5 {
+                let mut r = record(run);
+                r.horizon = Some(h);
+                r.time_s = 0.01 * 2f64.powi(h as i32) * (1.0 + 0.01 * f64::from(run));
+                r.quality_pct = Some(90.0 + f64::from(h) + f64::from(run));
+                recs.push(r);
+            }
+        }
+        let mut g = record(0);
+        g.algo = "greedy".into();
+        g.horizon = None;
+        g.branching_factor = None;
+        recs.push(g);
+        let s = summarize(&recs);
+        assert_eq!(s.groups.len(), 5);
+        let g0 = &s.groups[0];
+        assert_eq!((g0.algo.as_str(), g0.horizon, g0.n), ("greedy", None, 1));
+        assert!(g0.branching_factor.is_none() && g0.mean_branching_factor.is_none());
+        let h2 = s.groups.iter().find(|g| g.horizon == Some(2)).unwrap();
+        assert_eq!(h2.n, 5);
+        assert_eq!(h2.quality_pct.as_ref().unwrap().median, 94.0);
+        assert_eq!(h2.mean_branching_factor, Some(1.9));
+        assert_eq!(s.growth.len(), 1);
+        let all = s.growth[0].all.as_ref().unwrap();
+        assert!((all.alpha - 2.0).abs() < 1e-9, "{}", all.alpha);
+        let upper = s.growth[0].upper.as_ref().unwrap();
+        assert_eq!((upper.h_min, upper.h_max), (3, 4));
+        let csv = to_csv(&s);
+        assert_eq!(csv.lines().count(), 1 + 4 + 4 * 5);
+        assert!(csv.contains("m,selective,2,quality_pct,5,94,"), "{csv}");
+    }
+}

@@ -1,0 +1,159 @@
+//! CPU twin of `shaders/quad_quality.wgsl`: the same function on the same buffer layout, in
+//! f32, step for step. It is the oracle in the GPU tests and the fallback when no Vulkan
+//! adapter exists. Parallel over candidates with rayon (run it inside a one-thread pool for
+//! a serial figure).
+
+use super::layout::{Batch, Vertex};
+use rayon::prelude::*;
+
+const PI: f32 = std::f32::consts::PI;
+const FRAC_PI_2: f32 = std::f32::consts::FRAC_PI_2;
+const FRAC_PI_6: f32 = std::f32::consts::FRAC_PI_6;
+const SQRT_3: f32 = 1.732_050_8;
+const TAN_PI_12: f32 = 0.267_949_2;
+
+type V3 = [f32; 3];
+
+/// `b - a` with hi/lo compensation, scaled so that its largest component is 1.
+#[inline]
+fn edge(a: &Vertex, b: &Vertex) -> V3 {
+    let d: V3 = [0, 1, 2].map(|k| (b.hi[k] - a.hi[k]) + (b.lo[k] - a.lo[k]));
+    let m = d[0].abs().max(d[1].abs()).max(d[2].abs());
+    if m > 0.0 {
+        let s = 1.0 / m;
+        d.map(|x| x * s)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// atan(a) for a in [0, 1] (range reduction to |t| <= tan(pi/12), Taylor series to t^13).
+#[inline]
+fn atan_unit(a: f32) -> f32 {
+    let (t, base) = if a > TAN_PI_12 {
+        ((a * SQRT_3 - 1.0) / (a + SQRT_3), FRAC_PI_6)
+    } else {
+        (a, 0.0)
+    };
+    let s = t * t;
+    let p = 1.0
+        + s * (-1.0 / 3.0
+            + s * (1.0 / 5.0
+                + s * (-1.0 / 7.0 + s * (1.0 / 9.0 + s * (-1.0 / 11.0 + s * (1.0 / 13.0))))));
+    base + t * p
+}
+
+/// atan2(y, x) for y >= 0, in [0, pi]; (0, 0) gives 0.
+#[inline]
+fn atan2_pos(y: f32, x: f32) -> f32 {
+    let ax = x.abs();
+    let hi = y.max(ax);
+    if hi == 0.0 {
+        return 0.0;
+    }
+    let mut r = atan_unit(y.min(ax) / hi);
+    if y > ax {
+        r = FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = PI - r;
+    }
+    r
+}
+
+#[inline]
+fn angle(u: V3, v: V3) -> f32 {
+    let c = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let cn = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+    atan2_pos(cn, u[0] * v[0] + u[1] * v[1] + u[2] * v[2])
+}
+
+#[inline]
+fn neg(u: V3) -> V3 {
+    u.map(|x| -x)
+}
+
+/// The four interior angles of the quad `[s0, o1, s1, o0]` as the kernel computes them.
+pub fn quad_angles(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> [f32; 4] {
+    let a = edge(s0, s1);
+    let e0 = edge(s0, o0);
+    let e1 = edge(s0, o1);
+    let f0 = edge(s1, o0);
+    let f1 = edge(s1, o1);
+    [
+        angle(a, e0) + angle(e1, a),
+        angle(e1, f1),
+        angle(f0, neg(a)) + angle(neg(a), f1),
+        angle(f0, e0),
+    ]
+}
+
+/// eta of the quad `[s0, o1, s1, o0]`, as the kernel's `quad_eta`.
+pub fn quad_eta(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> f32 {
+    let alpha = quad_angles(s0, o1, s1, o0);
+    if alpha.iter().any(|&a| a <= 0.0 || a >= PI) {
+        return 0.0;
+    }
+    let worst = alpha
+        .iter()
+        .map(|&a| (FRAC_PI_2 - a).abs())
+        .fold(0.0f32, f32::max);
+    (1.0 - worst / FRAC_PI_2).max(0.0)
+}
+
+/// The kernel's entry point on the CPU: eta of every candidate of `batch`.
+pub fn quad_quality(batch: &Batch) -> Vec<f32> {
+    let v = &batch.vertices;
+    batch
+        .quads
+        .par_iter()
+        .with_min_len(4096)
+        .map(|q| {
+            quad_eta(
+                &v[q[0] as usize],
+                &v[q[1] as usize],
+                &v[q[2] as usize],
+                &v[q[3] as usize],
+            )
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polynomial_atan2_is_accurate() {
+        let mut worst = 0.0f64;
+        for i in 0..=20000 {
+            let t = i as f64 / 20000.0 * std::f64::consts::PI;
+            let (y, x) = (t.sin() as f32, t.cos() as f32);
+            let got = atan2_pos(y.abs(), x) as f64;
+            let want = (y.abs() as f64).atan2(x as f64);
+            worst = worst.max((got - want).abs());
+        }
+        assert!(worst < 5e-7, "worst atan2 error {worst}");
+        assert_eq!(atan2_pos(0.0, 0.0), 0.0);
+        assert_eq!(atan2_pos(0.0, -1.0), PI);
+    }
+
+    #[test]
+    fn twin_matches_f64_on_a_rhombus() {
+        let h = 3f64.sqrt() / 2.0;
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [0.5, -h, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.5, h, 0.0],
+        ];
+        let mut b = Batch::new();
+        b.push(&pts, &[[0, 1, 2, 3]]).unwrap();
+        let eta = quad_quality(&b);
+        assert!((eta[0] as f64 - crate::quality::quad_eta(pts)).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,465 @@
+//! Vulkan adapters and devices (created once, apart from the work) and the quality kernel
+//! on a device: [`Kernel`] (pipeline built once per device) and [`evaluate`].
+
+use super::layout::{Batch, Params, VERTEX_BYTES, Vertex};
+use super::{GpuError, shader};
+use std::borrow::Cow;
+use std::sync::mpsc;
+use std::time::Instant;
+
+/// Invocations per workgroup (`@workgroup_size` in the shader).
+const WORKGROUP: usize = 256;
+
+/// Every Vulkan adapter the loader reports, best first: discrete, integrated, virtual,
+/// other, then CPU (lavapipe). Set `VK_DRIVER_FILES` to choose the drivers.
+pub fn adapters() -> Vec<wgpu::Adapter> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+        backends: wgpu::Backends::VULKAN,
+        ..wgpu::InstanceDescriptor::new_without_display_handle()
+    });
+    let mut all = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
+    all.sort_by_key(|a| rank(a.get_info().device_type));
+    all
+}
+
+fn rank(t: wgpu::DeviceType) -> u8 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+/// True for a software adapter (lavapipe / llvmpipe).
+pub fn is_software(info: &wgpu::AdapterInfo) -> bool {
+    info.device_type == wgpu::DeviceType::Cpu
+}
+
+/// The name recorded in results, e.g. `vulkan: NVIDIA H200` or `vulkan: llvmpipe (...)`.
+pub fn adapter_name(info: &wgpu::AdapterInfo) -> String {
+    format!("{}: {}", info.backend, info.name)
+}
+
+/// Opens a device on `adapter` with the adapter's own limits (large storage buffers) and
+/// timestamp queries where supported.
+pub fn open_device(adapter: &wgpu::Adapter) -> Result<(wgpu::Device, wgpu::Queue), GpuError> {
+    let desc = wgpu::DeviceDescriptor {
+        label: Some("quadrecomb"),
+        required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
+        required_limits: adapter.limits(),
+        ..Default::default()
+    };
+    pollster::block_on(adapter.request_device(&desc)).map_err(|e| GpuError::RequestDevice {
+        adapter: adapter_name(&adapter.get_info()),
+        message: e.to_string(),
+    })
+}
+
+/// Time spent in each phase of a kernel run, summed over its dispatches (seconds).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Timings {
+    /// Host to device: buffer writes until the queue has them.
+    pub upload_s: f64,
+    /// Submit and wait for the dispatches (host clock).
+    pub kernel_s: f64,
+    /// The compute passes on the device's clock (timestamp queries), when supported.
+    pub kernel_device_s: Option<f64>,
+    /// Device to host: copy to a mappable buffer, map, copy out.
+    pub readback_s: f64,
+    /// Number of dispatches (chunks) the batch needed.
+    pub dispatches: usize,
+}
+
+impl Timings {
+    /// The kernel time: the device clock when available, else the host clock.
+    pub fn kernel_best_s(&self) -> f64 {
+        self.kernel_device_s.unwrap_or(self.kernel_s)
+    }
+}
+
+/// The quality pipeline on one device, built once and reused for every batch.
+#[derive(Debug)]
+pub struct Kernel {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    timestamps: bool,
+    max_chunk: usize,
+    max_vertices: usize,
+}
+
+/// Evaluates `batch` on `device` (building the pipeline first): eta per candidate, in batch
+/// order. Use a [`Kernel`] to build the pipeline once for many batches.
+pub fn evaluate(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    batch: &Batch,
+) -> Result<Vec<f32>, GpuError> {
+    Ok(Kernel::new(device)?.run(device, queue, batch)?.0)
+}
+
+/// Runs `f`, turning any wgpu validation or out-of-memory error it raises into a
+/// [`GpuError::Device`].
+fn checked<T>(device: &wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Result<T, GpuError> {
+    let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let val = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let out = f();
+    let e1 = pollster::block_on(val.pop());
+    let e2 = pollster::block_on(oom.pop());
+    match e1.or(e2) {
+        Some(e) => Err(GpuError::Device(format!("{what}: {e}"))),
+        None => Ok(out),
+    }
+}
+
+fn wait(device: &wgpu::Device) -> Result<(), GpuError> {
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map(|_| ())
+        .map_err(|e| GpuError::Device(format!("waiting for the device: {e}")))
+}
+
+/// Maps `buffer[..len]` for reading, waits, and returns a copy of the bytes.
+fn read_back(device: &wgpu::Device, buffer: &wgpu::Buffer, len: u64) -> Result<Vec<u8>, GpuError> {
+    let (tx, rx) = mpsc::channel();
+    buffer.map_async(wgpu::MapMode::Read, 0..len, move |r| {
+        let _ = tx.send(r);
+    });
+    wait(device)?;
+    rx.recv()
+        .map_err(|_| GpuError::Device("buffer map callback never ran".into()))?
+        .map_err(|e| GpuError::Device(format!("mapping a buffer: {e}")))?;
+    let bytes = buffer
+        .get_mapped_range(0..len)
+        .map_err(|e| GpuError::Device(format!("reading a mapped buffer: {e}")))?
+        .to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}
+
+impl Kernel {
+    /// Validates the shader with naga and builds the pipeline on `device`.
+    pub fn new(device: &wgpu::Device) -> Result<Kernel, GpuError> {
+        shader::validate(shader::QUAD_QUALITY, shader::QUAD_QUALITY_PATH)?;
+        let pipeline = checked(device, "building the quality pipeline", || {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(shader::QUAD_QUALITY_PATH),
+                source: wgpu::ShaderSource::Wgsl(Cow::Borrowed(shader::QUAD_QUALITY)),
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("quad_quality"),
+                layout: None,
+                module: &module,
+                entry_point: Some(shader::ENTRY_POINT),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })?;
+        let layout = pipeline.get_bind_group_layout(0);
+        Ok(Kernel {
+            pipeline,
+            layout,
+            timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+            max_chunk: usize::MAX,
+            max_vertices: usize::MAX,
+        })
+    }
+
+    /// Caps the candidates per dispatch and the vertices bound whole, below what the
+    /// device's limits allow (tests use this to exercise chunking and vertex compaction).
+    pub fn with_caps(mut self, max_chunk: usize, max_vertices: usize) -> Kernel {
+        self.max_chunk = max_chunk.max(1);
+        self.max_vertices = max_vertices;
+        self
+    }
+
+    /// True when the kernel time comes from timestamp queries.
+    pub fn has_timestamps(&self) -> bool {
+        self.timestamps
+    }
+
+    /// Evaluates `batch`: eta per candidate in batch order, and the time of each phase.
+    ///
+    /// The vertex buffer is uploaded once when it fits one storage binding; otherwise each
+    /// dispatch uploads the vertices its candidates use (compacted, indices remapped). The
+    /// candidates are split into dispatches that fit `max_storage_buffer_binding_size`,
+    /// `max_buffer_size` and a 2D grid of `max_compute_workgroups_per_dimension`.
+    pub fn run(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        batch: &Batch,
+    ) -> Result<(Vec<f32>, Timings), GpuError> {
+        let n = batch.len();
+        let mut timings = Timings::default();
+        if n == 0 {
+            return Ok((Vec::new(), timings));
+        }
+        let limits = device.limits();
+        let bind_max = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size) as usize;
+        let wg_max = limits.max_compute_workgroups_per_dimension as usize;
+        let whole = batch.vertices.len() * VERTEX_BYTES <= bind_max
+            && batch.vertices.len() <= self.max_vertices;
+        let mut chunk = (bind_max / 16)
+            .min(wg_max.saturating_mul(wg_max).saturating_mul(WORKGROUP))
+            .min(self.max_chunk)
+            .min(n);
+        if !whole {
+            // A compacted chunk has at most 4 vertices per candidate.
+            chunk = chunk
+                .min(bind_max / VERTEX_BYTES / 4)
+                .min(self.max_vertices / 4)
+                .max(1);
+        }
+        let vertex_cap = if whole {
+            batch.vertices.len()
+        } else {
+            (4 * chunk).min(batch.vertices.len())
+        };
+
+        let buffer = |label: &str, size: usize, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: (size.max(16) as u64).next_multiple_of(16),
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        use wgpu::BufferUsages as U;
+        let (params_buf, vertex_buf, quad_buf, eta_buf, read_buf, bind) =
+            checked(device, "allocating buffers", || {
+                let params_buf = buffer("params", 16, U::UNIFORM | U::COPY_DST);
+                let vertex_buf = buffer(
+                    "vertices",
+                    vertex_cap * VERTEX_BYTES,
+                    U::STORAGE | U::COPY_DST,
+                );
+                let quad_buf = buffer("quads", chunk * 16, U::STORAGE | U::COPY_DST);
+                let eta_buf = buffer("eta", chunk * 4, U::STORAGE | U::COPY_SRC);
+                let read_buf = buffer("eta readback", chunk * 4, U::MAP_READ | U::COPY_DST);
+                let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("quad_quality"),
+                    layout: &self.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: params_buf.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: vertex_buf.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: quad_buf.as_entire_binding(),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: eta_buf.as_entire_binding(),
+                        },
+                    ],
+                });
+                (params_buf, vertex_buf, quad_buf, eta_buf, read_buf, bind)
+            })?;
+        let queries = self.timestamps.then(|| {
+            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("kernel time"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            });
+            let resolve = buffer("timestamps", 16, U::QUERY_RESOLVE | U::COPY_SRC);
+            let read = buffer("timestamps readback", 16, U::MAP_READ | U::COPY_DST);
+            (set, resolve, read)
+        });
+        let period_ns = queue.get_timestamp_period() as f64;
+
+        let mut out = Vec::with_capacity(n);
+        let mut remap = if whole {
+            Vec::new()
+        } else {
+            vec![u32::MAX; batch.vertices.len()]
+        };
+        let mut local_vertices: Vec<Vertex> = Vec::new();
+        let mut local_quads: Vec<[u32; 4]> = Vec::new();
+        let mut device_s = 0.0;
+        for start in (0..n).step_by(chunk) {
+            let count = chunk.min(n - start);
+            let quads = &batch.quads[start..start + count];
+            let groups = count.div_ceil(WORKGROUP);
+            let (gx, gy) = if groups <= wg_max {
+                (groups, 1)
+            } else {
+                (wg_max, groups.div_ceil(wg_max))
+            };
+            let params = Params {
+                count: count as u32,
+                row: (gx * WORKGROUP) as u32,
+                vertex_base: 0,
+                pad: 0,
+            };
+
+            // Upload.
+            let t = Instant::now();
+            queue.write_buffer(&params_buf, 0, bytemuck::bytes_of(&params));
+            if whole {
+                if start == 0 {
+                    queue.write_buffer(&vertex_buf, 0, bytemuck::cast_slice(&batch.vertices));
+                }
+                queue.write_buffer(&quad_buf, 0, bytemuck::cast_slice(quads));
+            } else {
+                local_vertices.clear();
+                local_quads.clear();
+                for q in quads {
+                    local_quads.push(q.map(|v| {
+                        let r = &mut remap[v as usize];
+                        if *r == u32::MAX {
+                            *r = local_vertices.len() as u32;
+                            local_vertices.push(batch.vertices[v as usize]);
+                        }
+                        *r
+                    }));
+                }
+                for q in quads {
+                    for &v in q {
+                        remap[v as usize] = u32::MAX;
+                    }
+                }
+                queue.write_buffer(&vertex_buf, 0, bytemuck::cast_slice(&local_vertices));
+                queue.write_buffer(&quad_buf, 0, bytemuck::cast_slice(&local_quads));
+            }
+            queue.submit([]);
+            wait(device)?;
+            timings.upload_s += t.elapsed().as_secs_f64();
+
+            // Kernel.
+            let t = Instant::now();
+            let mut enc = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("quad_quality"),
+                    timestamp_writes: queries.as_ref().map(|(set, _, _)| {
+                        wgpu::ComputePassTimestampWrites {
+                            query_set: set,
+                            beginning_of_pass_write_index: Some(0),
+                            end_of_pass_write_index: Some(1),
+                        }
+                    }),
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.dispatch_workgroups(gx as u32, gy as u32, 1);
+            }
+            if let Some((set, resolve, read)) = &queries {
+                enc.resolve_query_set(set, 0..2, resolve, 0);
+                enc.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
+            }
+            checked(device, "running the quality kernel", || {
+                queue.submit([enc.finish()])
+            })?;
+            wait(device)?;
+            timings.kernel_s += t.elapsed().as_secs_f64();
+            if let Some((_, _, read)) = &queries {
+                let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&read_back(device, read, 16)?);
+                device_s += ticks[1].wrapping_sub(ticks[0]) as f64 * period_ns * 1e-9;
+            }
+
+            // Readback.
+            let t = Instant::now();
+            let bytes = (count * 4) as u64;
+            let mut enc = device.create_command_encoder(&Default::default());
+            enc.copy_buffer_to_buffer(&eta_buf, 0, &read_buf, 0, bytes);
+            queue.submit([enc.finish()]);
+            let data = read_back(device, &read_buf, bytes)?;
+            out.extend_from_slice(bytemuck::cast_slice::<u8, f32>(&data));
+            timings.readback_s += t.elapsed().as_secs_f64();
+            timings.dispatches += 1;
+        }
+        if queries.is_some() {
+            timings.kernel_device_s = Some(device_s);
+        }
+        Ok((out, timings))
+    }
+}
+
+/// Device memory bandwidth measured with a buffer-to-buffer copy of `bytes` bytes (read +
+/// write counted), in bytes per second: the bound the kernel is compared against.
+pub fn copy_bandwidth(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    bytes: u64,
+) -> Result<f64, GpuError> {
+    let limits = device.limits();
+    let bytes = bytes.min(limits.max_buffer_size).max(1 << 20) / 16 * 16;
+    let (src, dst) = checked(device, "allocating the bandwidth buffers", || {
+        let mk = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes,
+                usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        (mk("bandwidth src"), mk("bandwidth dst"))
+    })?;
+    let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+    let mut best = f64::INFINITY;
+    for _ in 0..5 {
+        let t = Instant::now();
+        let mut enc = device.create_command_encoder(&Default::default());
+        let queries = timestamps.then(|| {
+            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: None,
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            });
+            let mk = |usage| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: None,
+                    size: 16,
+                    usage,
+                    mapped_at_creation: false,
+                })
+            };
+            let resolve = mk(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
+            let read = mk(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+            (set, resolve, read)
+        });
+        // Timestamps around the copy from two empty compute passes (writing timestamps
+        // inside an encoder needs a feature few adapters have).
+        let mark = |enc: &mut wgpu::CommandEncoder, i: u32| {
+            if let Some((set, _, _)) = &queries {
+                enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: None,
+                    timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(i),
+                        end_of_pass_write_index: None,
+                    }),
+                });
+            }
+        };
+        mark(&mut enc, 0);
+        enc.copy_buffer_to_buffer(&src, 0, &dst, 0, bytes);
+        mark(&mut enc, 1);
+        if let Some((set, resolve, read)) = &queries {
+            enc.resolve_query_set(set, 0..2, resolve, 0);
+            enc.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
+        }
+        queue.submit([enc.finish()]);
+        wait(device)?;
+        let mut s = t.elapsed().as_secs_f64();
+        if let Some((_, _, read)) = &queries {
+            let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&read_back(device, read, 16)?);
+            let d =
+                ticks[1].wrapping_sub(ticks[0]) as f64 * queue.get_timestamp_period() as f64 * 1e-9;
+            if d > 0.0 {
+                s = d;
+            }
+        }
+        best = best.min(s);
+    }
+    Ok(2.0 * bytes as f64 / best)
+}

@@ -1,0 +1,1003 @@
+//! The hand-written MSH parser: 2.2 and 4.1, ASCII and binary (native little-endian, checked
+//! with the int `1` marker). One pass over the bytes, no per-line allocation.
+//!
+//! ASCII errors carry the line ([`ReadError::Syntax`]); errors inside binary data carry the
+//! byte offset (as [`ReadError::Io`] of kind `InvalidData`, whose message names the offset).
+
+use super::{MshFile, MshVersion};
+use crate::mesh::{MeshData, ReadError};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Number of nodes of each Gmsh element type (the ones Gmsh writes; 0 = unknown type).
+fn nodes_per_element(etype: i64) -> Option<usize> {
+    let n = match etype {
+        1 => 2,
+        2 => 3,
+        3 => 4,
+        4 => 4,
+        5 => 8,
+        6 => 6,
+        7 => 5,
+        8 => 3,
+        9 => 6,
+        10 => 9,
+        11 => 10,
+        12 => 27,
+        13 => 18,
+        14 => 14,
+        15 => 1,
+        16 => 8,
+        17 => 20,
+        18 => 15,
+        19 => 13,
+        20 => 9,
+        21 => 10,
+        22 => 12,
+        23 => 15,
+        24 => 15,
+        25 => 21,
+        26 => 4,
+        27 => 5,
+        28 => 6,
+        29 => 20,
+        30 => 35,
+        31 => 56,
+        92 => 64,
+        93 => 125,
+        _ => return None,
+    };
+    Some(n)
+}
+
+const TRIANGLE: i64 = 2;
+const QUAD: i64 = 3;
+
+/// Node tag -> dense vertex index.
+enum NodeMap {
+    Dense(Vec<u32>),
+    Sparse(HashMap<u64, u32>),
+}
+
+impl NodeMap {
+    /// The map for `tags` (in vertex order), or the first tag that appears twice.
+    fn new(tags: &[u64]) -> Result<NodeMap, u64> {
+        let max = tags.iter().copied().max().unwrap_or(0);
+        if max <= 4 * tags.len() as u64 + 1024 {
+            let mut dense = vec![u32::MAX; max as usize + 1];
+            for (i, &t) in tags.iter().enumerate() {
+                let slot = &mut dense[t as usize];
+                if *slot != u32::MAX {
+                    return Err(t);
+                }
+                *slot = i as u32;
+            }
+            Ok(NodeMap::Dense(dense))
+        } else {
+            let mut map = HashMap::with_capacity(tags.len());
+            for (i, &t) in tags.iter().enumerate() {
+                if map.insert(t, i as u32).is_some() {
+                    return Err(t);
+                }
+            }
+            Ok(NodeMap::Sparse(map))
+        }
+    }
+
+    #[inline]
+    fn get(&self, tag: u64) -> Option<u32> {
+        match self {
+            NodeMap::Dense(v) => v.get(tag as usize).copied().filter(|&i| i != u32::MAX),
+            NodeMap::Sparse(m) => m.get(&tag).copied(),
+        }
+    }
+}
+
+fn parse_u64(t: &[u8]) -> Option<u64> {
+    if t.is_empty() || t.len() > 20 {
+        return None;
+    }
+    let mut v: u64 = 0;
+    for &c in t {
+        let d = c.wrapping_sub(b'0');
+        if d > 9 {
+            return None;
+        }
+        v = v.checked_mul(10)?.checked_add(u64::from(d))?;
+    }
+    Some(v)
+}
+
+fn parse_i64(t: &[u8]) -> Option<i64> {
+    match t.split_first() {
+        Some((b'-', rest)) => parse_u64(rest)
+            .filter(|&v| v <= i64::MAX as u64 + 1)
+            .map(|v| (v as i64).wrapping_neg()),
+        Some((b'+', rest)) => parse_u64(rest).and_then(|v| i64::try_from(v).ok()),
+        _ => parse_u64(t).and_then(|v| i64::try_from(v).ok()),
+    }
+}
+
+fn parse_f64(t: &[u8]) -> Option<f64> {
+    std::str::from_utf8(t).ok()?.parse().ok()
+}
+
+/// Shows a token in a message: at most 40 characters, non-printable bytes escaped.
+fn show(t: &[u8]) -> String {
+    let s: String = t
+        .iter()
+        .take(40)
+        .flat_map(|&c| std::ascii::escape_default(c))
+        .map(char::from)
+        .collect();
+    if t.len() > 40 { format!("{s}...") } else { s }
+}
+
+struct Parser<'a> {
+    path: &'a Path,
+    b: &'a [u8],
+    pos: usize,
+    binary: bool,
+}
+
+type Res<T> = Result<T, ReadError>;
+
+impl<'a> Parser<'a> {
+    fn line_of(&self, pos: usize) -> usize {
+        1 + self.b[..pos.min(self.b.len())]
+            .iter()
+            .filter(|&&c| c == b'\n')
+            .count()
+    }
+
+    /// An error at text position `pos` (reported with its line).
+    fn err(&self, pos: usize, message: impl Into<String>) -> ReadError {
+        ReadError::Syntax {
+            path: self.path.to_path_buf(),
+            line: self.line_of(pos),
+            message: message.into(),
+        }
+    }
+
+    /// An error inside binary data at byte offset `pos`.
+    fn err_bin(&self, pos: usize, message: impl std::fmt::Display) -> ReadError {
+        ReadError::Io {
+            path: self.path.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("byte offset {pos}: {message}"),
+            ),
+        }
+    }
+
+    fn skip_ws(&mut self) {
+        while self.pos < self.b.len() && self.b[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+    }
+
+    /// Next whitespace-separated token and its position, or `None` at the end of the file.
+    #[inline]
+    fn token(&mut self) -> Option<(usize, &'a [u8])> {
+        self.skip_ws();
+        let start = self.pos;
+        let b = self.b;
+        let mut p = start;
+        while p < b.len() && !b[p].is_ascii_whitespace() {
+            p += 1;
+        }
+        self.pos = p;
+        if p == start {
+            None
+        } else {
+            Some((start, &b[start..p]))
+        }
+    }
+
+    /// Next token, or an error saying the file ends inside `section`.
+    #[inline]
+    fn need(&mut self, section: &str, what: &dyn Fn() -> String) -> Res<(usize, &'a [u8])> {
+        match self.token() {
+            Some(t) => Ok(t),
+            None => Err(self.err(
+                self.b.len(),
+                format!(
+                    "file is truncated: it ends inside {section} while {} was expected (missing $End{})",
+                    what(),
+                    section.trim_start_matches('$')
+                ),
+            )),
+        }
+    }
+
+    fn bad_token(
+        &self,
+        pos: usize,
+        tok: &[u8],
+        section: &str,
+        what: &dyn Fn() -> String,
+    ) -> ReadError {
+        if tok.first() == Some(&b'$') {
+            self.err(
+                pos,
+                format!(
+                    "found `{}` where {} was expected: {section} holds fewer entries than its header announces",
+                    show(tok),
+                    what()
+                ),
+            )
+        } else {
+            self.err(pos, format!("expected {}, found `{}`", what(), show(tok)))
+        }
+    }
+
+    #[inline]
+    fn uint(&mut self, section: &str, what: &dyn Fn() -> String) -> Res<u64> {
+        let (p, t) = self.need(section, what)?;
+        parse_u64(t).ok_or_else(|| self.bad_token(p, t, section, what))
+    }
+
+    #[inline]
+    fn int(&mut self, section: &str, what: &dyn Fn() -> String) -> Res<i64> {
+        let (p, t) = self.need(section, what)?;
+        parse_i64(t).ok_or_else(|| self.bad_token(p, t, section, what))
+    }
+
+    #[inline]
+    fn float(&mut self, section: &str, what: &dyn Fn() -> String) -> Res<(usize, f64)> {
+        let (p, t) = self.need(section, what)?;
+        parse_f64(t)
+            .map(|v| (p, v))
+            .ok_or_else(|| self.bad_token(p, t, section, what))
+    }
+
+    /// Skips the rest of the current line (ASCII element lines of unknown types).
+    fn skip_line(&mut self) {
+        while self.pos < self.b.len() && self.b[self.pos] != b'\n' {
+            self.pos += 1;
+        }
+    }
+
+    /// Expects the `$End...` token closing `section`, after `count` entries.
+    fn end(&mut self, section: &str, count: &dyn Fn() -> String) -> Res<()> {
+        let end = format!("$End{}", section.trim_start_matches('$'));
+        match self.token() {
+            Some((_, t)) if t == end.as_bytes() => Ok(()),
+            Some((p, t)) => Err(self.err(
+                p,
+                format!(
+                    "expected {end} after {}, found `{}`: {section} holds more than its header announces, or is not closed",
+                    count(),
+                    show(t)
+                ),
+            )),
+            None => Err(self.err(
+                self.b.len(),
+                format!("file is truncated: missing {end} (the file ends inside {section})"),
+            )),
+        }
+    }
+
+    /// Skips a section we do not read, up to its `$End...` marker.
+    fn skip_section(&mut self, start: usize, name: &[u8]) -> Res<()> {
+        let mut end = b"$End".to_vec();
+        end.extend_from_slice(&name[1..]);
+        let hay = &self.b[self.pos..];
+        match hay.windows(end.len()).position(|w| w == end.as_slice()) {
+            Some(i) => {
+                self.pos += i + end.len();
+                Ok(())
+            }
+            None => Err(self.err(
+                start,
+                format!(
+                    "file is truncated: section {} is never closed (missing {})",
+                    show(name),
+                    show(&end)
+                ),
+            )),
+        }
+    }
+
+    /// After a section header in a binary file: the single newline before the binary data.
+    fn newline_before_binary(&mut self) {
+        if self.b.get(self.pos) == Some(&b'\r') {
+            self.pos += 1;
+        }
+        if self.b.get(self.pos) == Some(&b'\n') {
+            self.pos += 1;
+        }
+    }
+
+    /// `n` bytes of binary data, or a truncation error naming `what`.
+    #[inline]
+    fn take(&mut self, n: usize, section: &str, what: &dyn Fn() -> String) -> Res<&'a [u8]> {
+        let left = self.b.len() - self.pos;
+        if n > left {
+            return Err(self.err_bin(
+                self.pos,
+                format!(
+                    "file is truncated inside {section}: {} needs {n} bytes, {left} left",
+                    what()
+                ),
+            ));
+        }
+        let s = &self.b[self.pos..self.pos + n];
+        self.pos += n;
+        Ok(s)
+    }
+
+    fn bin_i32(&mut self, section: &str, what: &dyn Fn() -> String) -> Res<i32> {
+        let s = self.take(4, section, what)?;
+        Ok(i32::from_le_bytes([s[0], s[1], s[2], s[3]]))
+    }
+
+    fn bin_u64(&mut self, section: &str, what: &dyn Fn() -> String) -> Res<u64> {
+        let s = self.take(8, section, what)?;
+        Ok(u64_at(s, 0))
+    }
+
+    /// `count * size` bytes, checked for overflow and truncation.
+    fn take_array(
+        &mut self,
+        count: u64,
+        size: usize,
+        section: &str,
+        what: &dyn Fn() -> String,
+    ) -> Res<&'a [u8]> {
+        let n = usize::try_from(count)
+            .ok()
+            .and_then(|c| c.checked_mul(size))
+            .ok_or_else(|| {
+                self.err_bin(self.pos, format!("{}: count {count} is too large", what()))
+            })?;
+        self.take(n, section, what)
+    }
+}
+
+#[inline]
+fn u64_at(s: &[u8], i: usize) -> u64 {
+    let mut a = [0u8; 8];
+    a.copy_from_slice(&s[i..i + 8]);
+    u64::from_le_bytes(a)
+}
+
+#[inline]
+fn f64_at(s: &[u8], i: usize) -> f64 {
+    let mut a = [0u8; 8];
+    a.copy_from_slice(&s[i..i + 8]);
+    f64::from_le_bytes(a)
+}
+
+#[inline]
+fn i32_at(s: &[u8], i: usize) -> i32 {
+    i32::from_le_bytes([s[i], s[i + 1], s[i + 2], s[i + 3]])
+}
+
+/// A capacity for `count` items of at least `min_bytes` each that the file can really hold.
+fn cap(count: u64, min_bytes: usize, bytes_left: usize) -> usize {
+    (count.min((bytes_left / min_bytes.max(1)) as u64)) as usize
+}
+
+/// The content of a MSH file, before validation.
+struct Content {
+    data: MeshData,
+    node_tags: Vec<u64>,
+    map: Option<NodeMap>,
+    ignored: usize,
+}
+
+/// True when `bytes` start (after whitespace and an optional UTF-8 BOM) with `$MeshFormat`.
+pub(super) fn looks_like_msh(bytes: &[u8]) -> bool {
+    let b = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let start = b
+        .iter()
+        .position(|c| !c.is_ascii_whitespace())
+        .unwrap_or(b.len());
+    b[start..].starts_with(b"$MeshFormat")
+}
+
+pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
+    if !looks_like_msh(bytes) {
+        return Err(ReadError::UnknownFormat {
+            path: path.to_path_buf(),
+            builtins: crate::mesh::builtin::NAMES.join(", "),
+        });
+    }
+    let mut p = Parser {
+        path,
+        b: bytes,
+        pos: if bytes.starts_with(b"\xEF\xBB\xBF") {
+            3
+        } else {
+            0
+        },
+        binary: false,
+    };
+    let fmt = "$MeshFormat";
+    p.token(); // $MeshFormat
+    let (vp, vt) = p.need(fmt, &|| "the version number".into())?;
+    let version = match vt {
+        b"4.1" => MshVersion::V41,
+        b"2.2" | b"2.1" | b"2.0" | b"2" => MshVersion::V22,
+        _ => {
+            return Err(p.err(
+                vp,
+                format!(
+                    "unsupported MSH version `{}` (quadrecomb reads versions 2.2 and 4.1)",
+                    show(vt)
+                ),
+            ));
+        }
+    };
+    let file_type = p.uint(fmt, &|| "the file type (0 = ASCII, 1 = binary)".into())?;
+    let (dp, _) = p.need(fmt, &|| "the data size".into())?;
+    let data_size = p.b[dp..p.pos].to_vec();
+    match file_type {
+        0 => {}
+        1 => {
+            p.binary = true;
+            if data_size != b"8" {
+                return Err(p.err(
+                    dp,
+                    format!(
+                        "unsupported data size `{}` in a binary file (only 8-byte size_t is read)",
+                        show(&data_size)
+                    ),
+                ));
+            }
+            p.newline_before_binary();
+            let at = p.pos;
+            let one = p.bin_i32(fmt, &|| "the endianness marker (int 1)".into())?;
+            if one != 1 {
+                let msg = if one.swap_bytes() == 1 {
+                    "big-endian binary MSH files are not supported (the int 1 marker is byte-swapped)"
+                        .to_string()
+                } else {
+                    format!("bad endianness marker {one} (expected the int 1)")
+                };
+                return Err(p.err_bin(at, msg));
+            }
+        }
+        _ => {
+            return Err(p.err(
+                dp,
+                format!("unknown file type {file_type} (expected 0 = ASCII or 1 = binary)"),
+            ));
+        }
+    }
+    p.end(fmt, &|| "the format line".into())?;
+
+    let mut c = Content {
+        data: MeshData::default(),
+        node_tags: Vec::new(),
+        map: None,
+        ignored: 0,
+    };
+    while let Some((start, name)) = p.token() {
+        match name {
+            b"$Nodes" => {
+                if c.map.is_some() {
+                    return Err(p.err(start, "a second $Nodes section"));
+                }
+                match (version, p.binary) {
+                    (MshVersion::V41, false) => nodes41_ascii(&mut p, &mut c)?,
+                    (MshVersion::V41, true) => nodes41_binary(&mut p, &mut c)?,
+                    (MshVersion::V22, false) => nodes22_ascii(&mut p, &mut c)?,
+                    (MshVersion::V22, true) => nodes22_binary(&mut p, &mut c)?,
+                }
+                p.end("$Nodes", &|| format!("{} nodes", c.node_tags.len()))?;
+                let map = NodeMap::new(&c.node_tags).map_err(|t| {
+                    p.err(start, format!("node tag {t} is defined twice in $Nodes"))
+                })?;
+                c.data.vertex_ids = std::mem::take(&mut c.node_tags);
+                c.map = Some(map);
+            }
+            b"$Elements" => {
+                let Some(map) = c.map.take() else {
+                    return Err(p.err(start, "$Elements comes before any $Nodes section"));
+                };
+                if !c.data.triangle_ids.is_empty() || !c.data.quad_ids.is_empty() || c.ignored > 0 {
+                    return Err(p.err(start, "a second $Elements section"));
+                }
+                let n = match (version, p.binary) {
+                    (MshVersion::V41, false) => elements41_ascii(&mut p, &mut c, &map)?,
+                    (MshVersion::V41, true) => elements41_binary(&mut p, &mut c, &map)?,
+                    (MshVersion::V22, false) => elements22_ascii(&mut p, &mut c, &map)?,
+                    (MshVersion::V22, true) => elements22_binary(&mut p, &mut c, &map)?,
+                };
+                p.end("$Elements", &|| format!("{n} elements"))?;
+                c.map = Some(map);
+            }
+            _ if name.first() == Some(&b'$') && !name.starts_with(b"$End") => {
+                p.skip_section(start, name)?;
+            }
+            _ => {
+                return Err(p.err(
+                    start,
+                    format!("unexpected `{}` outside any section", show(name)),
+                ));
+            }
+        }
+    }
+    Ok(MshFile {
+        data: c.data,
+        version,
+        binary: p.binary,
+        ignored_elements: c.ignored,
+    })
+}
+
+/// Checks that a node's coordinates are finite.
+fn check_finite(p: &Parser<'_>, at: usize, tag: u64, x: [f64; 3]) -> Res<()> {
+    if x.iter().all(|v| v.is_finite()) {
+        return Ok(());
+    }
+    let msg = format!(
+        "node {tag} has a non-finite coordinate ({}, {}, {})",
+        x[0], x[1], x[2]
+    );
+    Err(if p.binary {
+        p.err_bin(at, msg)
+    } else {
+        p.err(at, msg)
+    })
+}
+
+fn to_i32(p: &Parser<'_>, at: usize, v: i64, what: &str) -> Res<i32> {
+    i32::try_from(v).map_err(|_| {
+        let msg = format!("{what} {v} is out of range");
+        if p.binary {
+            p.err_bin(at, msg)
+        } else {
+            p.err(at, msg)
+        }
+    })
+}
+
+fn nodes41_ascii(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
+    let s = "$Nodes";
+    let hp = p.pos;
+    let blocks = p.uint(s, &|| "the number of entity blocks".into())?;
+    let total = p.uint(s, &|| "the number of nodes".into())?;
+    p.uint(s, &|| "the minimum node tag".into())?;
+    p.uint(s, &|| "the maximum node tag".into())?;
+    let left = p.b.len() - p.pos;
+    c.node_tags.reserve(cap(total, 8, left));
+    c.data.vertices.reserve(cap(total, 8, left));
+    for blk in 0..blocks {
+        let what_blk = || format!("the header of node block {} of {blocks}", blk + 1);
+        let dim = p.int(s, &what_blk)?;
+        p.int(s, &what_blk)?;
+        let parametric = p.uint(s, &what_blk)?;
+        let bp = p.pos;
+        let n = p.uint(s, &what_blk)?;
+        let have = c.node_tags.len() as u64;
+        if n > total - have.min(total) {
+            return Err(p.err(
+                bp,
+                format!(
+                    "node block {} holds {n} nodes, more than the {total} nodes announced in the header",
+                    blk + 1
+                ),
+            ));
+        }
+        let extra = match (parametric, dim) {
+            (0, _) => 0,
+            (1, d @ 0..=3) => d as usize,
+            _ => {
+                return Err(p.err(
+                    bp,
+                    format!("bad parametric flag {parametric} for an entity of dimension {dim}"),
+                ));
+            }
+        };
+        for i in 0..n {
+            let tag = p.uint(s, &|| format!("node tag {} of block {}", i + 1, blk + 1))?;
+            c.node_tags.push(tag);
+        }
+        let first = c.node_tags.len() - n as usize;
+        for i in 0..n as usize {
+            let tag = c.node_tags[first + i];
+            let what = || format!("a coordinate of node {tag}");
+            let (at, x) = p.float(s, &what)?;
+            let (_, y) = p.float(s, &what)?;
+            let (_, z) = p.float(s, &what)?;
+            check_finite(p, at, tag, [x, y, z])?;
+            for _ in 0..extra {
+                p.float(s, &|| format!("a parametric coordinate of node {tag}"))?;
+            }
+            c.data.vertices.push([x, y, z]);
+        }
+    }
+    if c.node_tags.len() as u64 != total {
+        return Err(p.err(
+            hp,
+            format!(
+                "the $Nodes header announces {total} nodes but its blocks hold {}",
+                c.node_tags.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn nodes41_binary(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
+    let s = "$Nodes";
+    p.newline_before_binary();
+    let hp = p.pos;
+    let blocks = p.bin_u64(s, &|| "the number of entity blocks".into())?;
+    let total = p.bin_u64(s, &|| "the number of nodes".into())?;
+    p.bin_u64(s, &|| "the minimum node tag".into())?;
+    p.bin_u64(s, &|| "the maximum node tag".into())?;
+    let left = p.b.len() - p.pos;
+    c.node_tags.reserve(cap(total, 32, left));
+    c.data.vertices.reserve(cap(total, 32, left));
+    for blk in 0..blocks {
+        let what_blk = || format!("the header of node block {} of {blocks}", blk + 1);
+        let dim = p.bin_i32(s, &what_blk)?;
+        p.bin_i32(s, &what_blk)?;
+        let parametric = p.bin_i32(s, &what_blk)?;
+        let bp = p.pos;
+        let n = p.bin_u64(s, &what_blk)?;
+        let have = c.node_tags.len() as u64;
+        if n > total - have.min(total) {
+            return Err(p.err_bin(
+                bp,
+                format!(
+                    "node block {} holds {n} nodes, more than the {total} nodes announced in the header",
+                    blk + 1
+                ),
+            ));
+        }
+        let extra = match (parametric, dim) {
+            (0, _) => 0,
+            (1, d @ 0..=3) => d as usize,
+            _ => {
+                return Err(p.err_bin(
+                    bp,
+                    format!("bad parametric flag {parametric} for an entity of dimension {dim}"),
+                ));
+            }
+        };
+        let what_tags = || format!("the node tags of block {}", blk + 1);
+        let tags = p.take_array(n, 8, s, &what_tags)?;
+        c.node_tags
+            .extend(tags.chunks_exact(8).map(|t| u64_at(t, 0)));
+        let first = c.node_tags.len() - n as usize;
+        let stride = 8 * (3 + extra);
+        let cp = p.pos;
+        let what_xyz = || format!("the coordinates of block {}", blk + 1);
+        let xyz = p.take_array(n, stride, s, &what_xyz)?;
+        for (i, v) in xyz.chunks_exact(stride).enumerate() {
+            let x = [f64_at(v, 0), f64_at(v, 8), f64_at(v, 16)];
+            check_finite(p, cp + i * stride, c.node_tags[first + i], x)?;
+            c.data.vertices.push(x);
+        }
+    }
+    if c.node_tags.len() as u64 != total {
+        return Err(p.err_bin(
+            hp,
+            format!(
+                "the $Nodes header announces {total} nodes but its blocks hold {}",
+                c.node_tags.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn nodes22_ascii(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
+    let s = "$Nodes";
+    let total = p.uint(s, &|| "the number of nodes".into())?;
+    let left = p.b.len() - p.pos;
+    c.node_tags.reserve(cap(total, 8, left));
+    c.data.vertices.reserve(cap(total, 8, left));
+    for i in 0..total {
+        let tag = p.uint(s, &|| format!("the tag of node {} of {total}", i + 1))?;
+        let what = || format!("a coordinate of node {tag}");
+        let (at, x) = p.float(s, &what)?;
+        let (_, y) = p.float(s, &what)?;
+        let (_, z) = p.float(s, &what)?;
+        check_finite(p, at, tag, [x, y, z])?;
+        c.node_tags.push(tag);
+        c.data.vertices.push([x, y, z]);
+    }
+    Ok(())
+}
+
+fn nodes22_binary(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
+    let s = "$Nodes";
+    let total = p.uint(s, &|| "the number of nodes".into())?;
+    p.newline_before_binary();
+    let at = p.pos;
+    let data = p.take_array(total, 28, s, &|| format!("{total} nodes"))?;
+    c.node_tags.reserve(total as usize);
+    c.data.vertices.reserve(total as usize);
+    for (i, v) in data.chunks_exact(28).enumerate() {
+        let tag = i32_at(v, 0);
+        let pos = at + 28 * i;
+        if tag <= 0 {
+            return Err(p.err_bin(pos, format!("bad node tag {tag} (tags are positive)")));
+        }
+        let x = [f64_at(v, 4), f64_at(v, 12), f64_at(v, 20)];
+        check_finite(p, pos, tag as u64, x)?;
+        c.node_tags.push(tag as u64);
+        c.data.vertices.push(x);
+    }
+    Ok(())
+}
+
+/// Adds a triangle or quad (`nodes` are its 3 or 4 node tags) of element `tag` on `surface`, or counts an
+/// ignored element. `at` is where the element starts (for messages).
+#[inline]
+fn push_element(
+    p: &Parser<'_>,
+    c: &mut Content,
+    map: &NodeMap,
+    at: usize,
+    tag: u64,
+    surface: i32,
+    nodes: &[u64],
+) -> Res<()> {
+    let mut idx = [0u32; 4];
+    for (k, &n) in nodes.iter().enumerate() {
+        idx[k] = map.get(n).ok_or_else(|| {
+            let msg = format!("element {tag} refers to node {n}, which does not exist");
+            if p.binary {
+                p.err_bin(at, msg)
+            } else {
+                p.err(at, msg)
+            }
+        })?;
+    }
+    if nodes.len() == 3 {
+        c.data.triangles.push([idx[0], idx[1], idx[2]]);
+        c.data.triangle_ids.push(tag);
+        c.data.triangle_surface.push(surface);
+    } else {
+        c.data.quads.push(idx);
+        c.data.quad_ids.push(tag);
+        c.data.quad_surface.push(surface);
+    }
+    Ok(())
+}
+
+fn elements41_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
+    let s = "$Elements";
+    let hp = p.pos;
+    let blocks = p.uint(s, &|| "the number of entity blocks".into())?;
+    let total = p.uint(s, &|| "the number of elements".into())?;
+    p.uint(s, &|| "the minimum element tag".into())?;
+    p.uint(s, &|| "the maximum element tag".into())?;
+    let mut seen = 0u64;
+    let mut nodes = [0u64; 4];
+    for blk in 0..blocks {
+        let what_blk = || format!("the header of element block {} of {blocks}", blk + 1);
+        p.int(s, &what_blk)?;
+        let ep = p.pos;
+        let entity = p.int(s, &what_blk)?;
+        let etype = p.int(s, &what_blk)?;
+        let bp = p.pos;
+        let n = p.uint(s, &what_blk)?;
+        if n > total - seen.min(total) {
+            return Err(p.err(
+                bp,
+                format!(
+                    "element block {} holds {n} elements, more than the {total} announced in the header",
+                    blk + 1
+                ),
+            ));
+        }
+        let surface = to_i32(p, ep, entity, "entity tag")?;
+        let keep = etype == TRIANGLE || etype == QUAD;
+        let nn = nodes_per_element(etype);
+        if keep {
+            let nn = if etype == TRIANGLE { 3 } else { 4 };
+            let left = p.b.len() - p.pos;
+            if etype == TRIANGLE {
+                let k = cap(n, 8, left);
+                c.data.triangles.reserve(k);
+                c.data.triangle_ids.reserve(k);
+                c.data.triangle_surface.reserve(k);
+            }
+            for i in 0..n {
+                let (at, tt) = p.need(s, &|| format!("element {} of block {}", i + 1, blk + 1))?;
+                let tag = parse_u64(tt).ok_or_else(|| {
+                    p.bad_token(at, tt, s, &|| {
+                        format!("the tag of element {} of block {}", i + 1, blk + 1)
+                    })
+                })?;
+                for slot in nodes.iter_mut().take(nn) {
+                    *slot = p.uint(s, &|| format!("a node of element {tag}"))?;
+                }
+                push_element(p, c, map, at, tag, surface, &nodes[..nn])?;
+            }
+        } else {
+            for i in 0..n {
+                p.uint(s, &|| {
+                    format!("the tag of element {} of block {}", i + 1, blk + 1)
+                })?;
+                match nn {
+                    Some(k) => {
+                        for _ in 0..k {
+                            p.uint(s, &|| {
+                                format!("a node of element {} of block {}", i + 1, blk + 1)
+                            })?;
+                        }
+                    }
+                    None => p.skip_line(),
+                }
+            }
+            c.ignored += n as usize;
+        }
+        seen += n;
+    }
+    if seen != total {
+        return Err(p.err(
+            hp,
+            format!("the $Elements header announces {total} elements but its blocks hold {seen}"),
+        ));
+    }
+    Ok(total)
+}
+
+fn elements41_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
+    let s = "$Elements";
+    p.newline_before_binary();
+    let hp = p.pos;
+    let blocks = p.bin_u64(s, &|| "the number of entity blocks".into())?;
+    let total = p.bin_u64(s, &|| "the number of elements".into())?;
+    p.bin_u64(s, &|| "the minimum element tag".into())?;
+    p.bin_u64(s, &|| "the maximum element tag".into())?;
+    let mut seen = 0u64;
+    let mut nodes = [0u64; 4];
+    for blk in 0..blocks {
+        let what_blk = || format!("the header of element block {} of {blocks}", blk + 1);
+        p.bin_i32(s, &what_blk)?;
+        let entity = p.bin_i32(s, &what_blk)?;
+        let tp = p.pos;
+        let etype = i64::from(p.bin_i32(s, &what_blk)?);
+        let bp = p.pos;
+        let n = p.bin_u64(s, &what_blk)?;
+        if n > total - seen.min(total) {
+            return Err(p.err_bin(
+                bp,
+                format!(
+                    "element block {} holds {n} elements, more than the {total} announced in the header",
+                    blk + 1
+                ),
+            ));
+        }
+        let Some(nn) = nodes_per_element(etype) else {
+            return Err(p.err_bin(tp, format!("unknown element type {etype}")));
+        };
+        let stride = 8 * (1 + nn);
+        let at0 = p.pos;
+        let data = p.take_array(n, stride, s, &|| format!("element block {}", blk + 1))?;
+        if etype == TRIANGLE || etype == QUAD {
+            for (i, e) in data.chunks_exact(stride).enumerate() {
+                let tag = u64_at(e, 0);
+                for (k, slot) in nodes.iter_mut().take(nn).enumerate() {
+                    *slot = u64_at(e, 8 + 8 * k);
+                }
+                push_element(p, c, map, at0 + i * stride, tag, entity, &nodes[..nn])?;
+            }
+        } else {
+            c.ignored += n as usize;
+        }
+        seen += n;
+    }
+    if seen != total {
+        return Err(p.err_bin(
+            hp,
+            format!("the $Elements header announces {total} elements but its blocks hold {seen}"),
+        ));
+    }
+    Ok(total)
+}
+
+/// Surface of an MSH 2.2 element: its elementary tag (the second tag), else 1.
+fn surface22(tags: &[i64]) -> i64 {
+    tags.get(1).copied().unwrap_or(1)
+}
+
+fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
+    let s = "$Elements";
+    let total = p.uint(s, &|| "the number of elements".into())?;
+    let left = p.b.len() - p.pos;
+    let k = cap(total, 12, left);
+    c.data.triangles.reserve(k);
+    c.data.triangle_ids.reserve(k);
+    c.data.triangle_surface.reserve(k);
+    let mut nodes = [0u64; 4];
+    let mut tags = [0i64; 2];
+    for i in 0..total {
+        let (at, tt) = p.need(s, &|| format!("element {} of {total}", i + 1))?;
+        let tag = parse_u64(tt).ok_or_else(|| {
+            p.bad_token(at, tt, s, &|| {
+                format!("the tag of element {} of {total}", i + 1)
+            })
+        })?;
+        let etype = p.int(s, &|| format!("the type of element {tag}"))?;
+        let ntags = p.uint(s, &|| format!("the number of tags of element {tag}"))?;
+        for k in 0..ntags {
+            let v = p.int(s, &|| format!("a tag of element {tag}"))?;
+            if let Some(slot) = tags.get_mut(k as usize) {
+                *slot = v;
+            }
+        }
+        if etype == TRIANGLE || etype == QUAD {
+            let nn = if etype == TRIANGLE { 3 } else { 4 };
+            for slot in nodes.iter_mut().take(nn) {
+                *slot = p.uint(s, &|| format!("a node of element {tag}"))?;
+            }
+            let used = &tags[..(ntags as usize).min(2)];
+            let surface = to_i32(p, at, surface22(used), "elementary tag")?;
+            push_element(p, c, map, at, tag, surface, &nodes[..nn])?;
+        } else {
+            match nodes_per_element(etype) {
+                Some(k) => {
+                    for _ in 0..k {
+                        p.uint(s, &|| format!("a node of element {tag}"))?;
+                    }
+                }
+                None => p.skip_line(),
+            }
+            c.ignored += 1;
+        }
+    }
+    Ok(total)
+}
+
+fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
+    let s = "$Elements";
+    let total = p.uint(s, &|| "the number of elements".into())?;
+    p.newline_before_binary();
+    let mut seen = 0u64;
+    let mut nodes = [0u64; 4];
+    while seen < total {
+        let hp = p.pos;
+        let what = || format!("the header of an element group ({seen} of {total} elements read)");
+        let etype = i64::from(p.bin_i32(s, &what)?);
+        let n = p.bin_i32(s, &what)?;
+        let ntags = p.bin_i32(s, &what)?;
+        if n <= 0 || n as u64 > total - seen || ntags < 0 {
+            return Err(p.err_bin(
+                hp,
+                format!(
+                    "bad element group header: type {etype}, {n} elements, {ntags} tags ({} of {total} elements left)",
+                    total - seen
+                ),
+            ));
+        }
+        let Some(nn) = nodes_per_element(etype) else {
+            return Err(p.err_bin(hp, format!("unknown element type {etype}")));
+        };
+        let ntags = ntags as usize;
+        let stride = 4 * (1 + ntags + nn);
+        let at0 = p.pos;
+        let data = p.take_array(n as u64, stride, s, &|| {
+            format!("{n} elements of type {etype}")
+        })?;
+        if etype == TRIANGLE || etype == QUAD {
+            for (i, e) in data.chunks_exact(stride).enumerate() {
+                let at = at0 + i * stride;
+                let tag = i32_at(e, 0);
+                if tag <= 0 {
+                    return Err(p.err_bin(at, format!("bad element tag {tag} (tags are positive)")));
+                }
+                let surface = if ntags >= 2 { i32_at(e, 8) } else { 1 };
+                for (k, slot) in nodes.iter_mut().take(nn).enumerate() {
+                    let v = i32_at(e, 4 * (1 + ntags + k));
+                    *slot = u64::try_from(v).unwrap_or(0);
+                }
+                push_element(p, c, map, at, tag as u64, surface, &nodes[..nn])?;
+            }
+        } else {
+            c.ignored += n as usize;
+        }
+        seen += n as u64;
+    }
+    Ok(total)
+}
