@@ -10,7 +10,6 @@
 
 mod document;
 mod format;
-mod numbers;
 pub mod paper;
 pub mod picture;
 pub mod plots;
@@ -20,8 +19,8 @@ pub mod significance;
 pub use document::{Block, Document};
 pub use results::{Config, Metric, Results, Run};
 
+use crate::stats::describe::{BoxStats, median};
 use format::{fmt_opt, fmt_sig};
-use numbers::{BoxStats, growth_fit, median};
 use plots::{Extras, HorizonBox, boxplot_svg};
 use significance::Family;
 use std::path::{Path, PathBuf};
@@ -37,22 +36,15 @@ pub enum ReportError {
         /// The cause.
         source: std::io::Error,
     },
-    /// A results file is malformed (not a torn last line).
-    #[error("{path}:{line}: {message}")]
-    Syntax {
-        /// The file.
-        path: PathBuf,
-        /// 1-based line.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// `runs.jsonl` holds no run.
+    /// `runs.jsonl` is missing or holds no run.
     #[error("{path}: no runs recorded")]
     NoRuns {
         /// The file.
         path: PathBuf,
     },
+    /// The runner's files (`runs.jsonl`, `manifest.json`) could not be read.
+    #[error(transparent)]
+    Results(#[from] crate::experiment::ExperimentError),
     /// plotters failed to draw (an internal error).
     #[error("drawing a figure failed: {0}")]
     Plot(String),
@@ -171,21 +163,33 @@ fn overview(doc: &mut Document, results: &Results) {
         backends.join(", "),
     ));
     if let Some(m) = &results.manifest {
-        let machine = &m["machine"];
-        if machine.is_object() {
+        let machine = |m: &crate::experiment::manifest::Machine| {
+            format!("{} ({} logical cores), {}", m.cpu, m.cores, m.os)
+        };
+        if m.merged_from.is_empty() {
             doc.para(format!(
-                "Machine: {} ({} logical cores), {}; {} worker thread(s). Base seed {}.",
-                machine["cpu"].as_str().unwrap_or("?"),
-                machine["cores"].as_u64().unwrap_or(0),
-                machine["os"].as_str().unwrap_or("?"),
-                m["threads"].as_u64().unwrap_or(0),
-                m["spec"]["seed"]
-                    .as_u64()
-                    .map_or("?".into(), |s| s.to_string()),
+                "Machine: {}; {} worker thread(s). Base seed {}; {} runs per horizon, {} per \
+                 baseline.",
+                machine(&m.machine),
+                m.threads,
+                m.spec.seed,
+                m.spec.runs,
+                m.spec.baseline_runs,
+            ));
+        } else {
+            let parts: Vec<String> = m
+                .merged_from
+                .iter()
+                .map(|p| format!("{} ({} runs): {}", p.dir, p.records, machine(&p.machine)))
+                .collect();
+            doc.para(format!(
+                "Merged from shards run on: {}. Base seed {}.",
+                parts.join("; "),
+                m.spec.seed
             ));
         }
     }
-    if results.skipped_lines > 0 {
+    if results.torn_bytes > 0 {
         doc.para(
             "The last line of runs.jsonl was torn (a run interrupted while being written) and is \
              not counted; `quadrecomb sweep --resume` redoes it.",
@@ -201,11 +205,13 @@ fn overview(doc: &mut Document, results: &Results) {
 
 /// The optimum quality of `mesh` from the manifest, if recorded.
 fn optimum_of(results: &Results, mesh: &str) -> Option<f64> {
-    results.manifest.as_ref()?["optimum"]
-        .as_array()?
+    results
+        .manifest
+        .as_ref()?
+        .optimum
         .iter()
-        .find(|o| o["mesh"].as_str() == Some(mesh))?["quality"]
-        .as_f64()
+        .find(|o| o.mesh == mesh)
+        .map(|o| o.quality)
 }
 
 /// File-name-safe form of a label.
@@ -262,7 +268,7 @@ fn mesh_section(
                 format!("{:.2}", median(&Metric::Recombined.values(runs))),
                 fmt_sig(median(&Metric::Time.values(runs)), 3),
                 fmt_sig(
-                    median(&runs.iter().map(Run::nodes_per_step).collect::<Vec<_>>()),
+                    median(&runs.iter().map(results::nodes_per_step).collect::<Vec<_>>()),
                     3,
                 ),
                 fmt_opt(median_opt(runs, |r| r.branching_factor), 3),
@@ -423,19 +429,25 @@ fn box_plots(
             );
             let log_y = metric == Metric::Time;
             if log_y {
-                let pts: Vec<(u32, f64)> =
-                    boxes.iter().map(|b| (b.horizon, b.stats.median)).collect();
-                // The asymptotic slope: fit the upper half of the horizons (at least two).
-                let keep = (pts.len() / 2).max(2).min(pts.len());
-                extras.fit = growth_fit(&pts[pts.len() - keep..]);
-                match &extras.fit {
-                    Some(f) => caption.push_str(&format!(
-                        " Logarithmic axis. Green: least-squares fit of log10(median time) on \
-                         h = {}..{}, slope {:.3} per horizon, branching factor alpha = 10^slope = \
-                         {:.3} (the paper reports 1.33 on its Borouchaki mesh).",
+                // The runner's growth fits (as in summary.json): log10(median time) on h over
+                // every horizon, and over the upper half where the paper reads alpha.
+                let growth = crate::experiment::summary::summarize(&all).growth;
+                let entry = growth.iter().find(|g| g.algo == algo);
+                extras.fit = entry.and_then(|g| g.upper.clone().or_else(|| g.all.clone()));
+                caption.push_str(" Logarithmic axis.");
+                if let Some(f) = &extras.fit {
+                    caption.push_str(&format!(
+                        " Green: least-squares fit of log10(median time) on h = {}..{}, slope {:.3} \
+                         per horizon, branching factor alpha = 10^slope = {:.3}",
                         f.h_min, f.h_max, f.fit.slope, f.alpha
-                    )),
-                    None => caption.push_str(" Logarithmic axis."),
+                    ));
+                    if let Some(a) = entry.and_then(|g| g.all.as_ref()) {
+                        caption.push_str(&format!(
+                            " (over every horizon h = {}..{}: alpha = {:.3})",
+                            a.h_min, a.h_max, a.alpha
+                        ));
+                    }
+                    caption.push_str("; the paper reports 1.33 on its Borouchaki mesh.");
                 }
             }
             let svg = boxplot_svg(&format!("{mesh}: {algo}"), name, &boxes, log_y, &extras)?;

@@ -7,7 +7,7 @@
 //! element ids), so tests and readers can find and count them.
 
 use super::ReportError;
-use super::numbers::{BoxStats, Growth};
+use crate::stats::describe::{BoxStats, Growth};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, Ranged};
 use plotters::prelude::*;

@@ -2,66 +2,17 @@
 //! into configurations (mesh, algorithm, horizon).
 
 use super::ReportError;
-use serde::Deserialize;
+pub use crate::experiment::record::RunRecord as Run;
+use crate::experiment::{manifest, store};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// One run as the report reads it from `runs.jsonl` (the runner's `RunRecord` fields the report
-/// uses; other fields are ignored).
-#[derive(Debug, Clone, Deserialize)]
-pub struct Run {
-    /// Mesh name or path as given to the sweep.
-    pub mesh: String,
-    /// Hash of the mesh the run used.
-    #[serde(default)]
-    pub mesh_hash: String,
-    /// Number of triangles of the input mesh.
-    pub triangles: usize,
-    /// Policy name ("greedy-nocrit", "greedy", "uniform", "selective").
-    pub algo: String,
-    /// Horizon of the look-ahead policies.
-    #[serde(default)]
-    pub horizon: Option<u32>,
-    /// The run's own seed.
-    pub seed: u64,
-    /// Run index within its configuration.
-    pub run: u32,
-    /// Quads made.
-    pub quads: usize,
-    /// Triangles left unrecombined.
-    pub triangles_left: usize,
-    /// Percentage of triangles recombined.
-    pub recombined_pct: f64,
-    /// Total quality (sum of eta).
-    pub quality: f64,
-    /// Quality as a percentage of the optimum, when the optimum is known.
-    #[serde(default)]
-    pub quality_pct: Option<f64>,
-    /// Wall time of the run in seconds.
-    pub time_s: f64,
-    /// Tree nodes expanded.
-    pub nodes_expanded: u64,
-    /// Decisions (recombinations) made.
-    pub decisions: u64,
-    /// Effective branching factor of the look-ahead tree, when there is one.
-    #[serde(default)]
-    pub branching_factor: Option<f64>,
-    /// Backend that filled the candidate table's eta.
-    #[serde(default)]
-    pub backend: String,
-    /// Tool version that produced the run.
-    #[serde(default)]
-    pub version: String,
-}
-
-impl Run {
-    /// Tree nodes expanded per decision (0 when no decision was made).
-    pub fn nodes_per_step(&self) -> f64 {
-        if self.decisions == 0 {
-            0.0
-        } else {
-            self.nodes_expanded as f64 / self.decisions as f64
-        }
+/// Tree nodes expanded per decision of a run (0 when no decision was made).
+pub fn nodes_per_step(run: &Run) -> f64 {
+    if run.decisions == 0 {
+        0.0
+    } else {
+        run.nodes_expanded as f64 / run.decisions as f64
     }
 }
 
@@ -121,67 +72,43 @@ pub struct Results {
     /// Meshes in report order (order of first appearance in `runs.jsonl`).
     pub meshes: Vec<String>,
     /// `manifest.json`, if present.
-    pub manifest: Option<serde_json::Value>,
-    /// Lines of `runs.jsonl` that could not be read (only a torn last line is tolerated).
-    pub skipped_lines: usize,
+    pub manifest: Option<manifest::Manifest>,
+    /// Bytes of a torn last line of `runs.jsonl` (a run interrupted while being written),
+    /// ignored; 0 if none.
+    pub torn_bytes: u64,
 }
 
 impl Results {
-    /// Reads `dir/runs.jsonl` and, if present, `dir/manifest.json`. A torn (unparsable) last line
-    /// is skipped, as the runner redoes it on `--resume`; any other bad line is an error.
+    /// Reads `dir/runs.jsonl` (through the runner's reader: a torn last line is ignored, any
+    /// other bad line is an error) and, if present, `dir/manifest.json`.
     pub fn read(dir: &Path) -> Result<Results, ReportError> {
-        let path = dir.join("runs.jsonl");
-        let text = std::fs::read_to_string(&path).map_err(|source| ReportError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        let lines: Vec<(usize, &str)> = text
-            .lines()
-            .enumerate()
-            .filter(|(_, l)| !l.trim().is_empty())
-            .collect();
-        let mut runs = Vec::with_capacity(lines.len());
-        let mut skipped_lines = 0;
-        for (k, &(i, line)) in lines.iter().enumerate() {
-            match serde_json::from_str::<Run>(line) {
-                Ok(r) => runs.push(r),
-                Err(_) if k + 1 == lines.len() && !text.ends_with('\n') => skipped_lines += 1,
-                Err(e) => {
-                    return Err(ReportError::Syntax {
-                        path: path.clone(),
-                        line: i + 1,
-                        message: e.to_string(),
-                    });
-                }
-            }
-        }
-        if runs.is_empty() {
+        let path = dir.join(store::RUNS_FILE);
+        if !path.is_file() {
             return Err(ReportError::NoRuns { path });
         }
-        let manifest_path = dir.join("manifest.json");
-        let manifest = match std::fs::read_to_string(&manifest_path) {
-            Ok(t) => Some(serde_json::from_str(&t).map_err(|e| ReportError::Syntax {
-                path: manifest_path.clone(),
-                line: e.line(),
-                message: e.to_string(),
-            })?),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-            Err(source) => {
-                return Err(ReportError::Io {
-                    path: manifest_path,
-                    source,
-                });
-            }
+        let loaded = store::read(&path)?;
+        if loaded.records.is_empty() {
+            return Err(ReportError::NoRuns { path });
+        }
+        let manifest = if dir.join(manifest::MANIFEST_FILE).is_file() {
+            Some(manifest::Manifest::read(dir)?)
+        } else {
+            None
         };
-        Ok(Results::from_runs(dir, runs, manifest, skipped_lines))
+        Ok(Results::from_runs(
+            dir,
+            loaded.records,
+            manifest,
+            loaded.torn_bytes,
+        ))
     }
 
     /// Groups `runs` (already read) by configuration.
     pub fn from_runs(
         dir: &Path,
         runs: Vec<Run>,
-        manifest: Option<serde_json::Value>,
-        skipped_lines: usize,
+        manifest: Option<manifest::Manifest>,
+        torn_bytes: u64,
     ) -> Results {
         let mut meshes: Vec<String> = Vec::new();
         let mut groups: BTreeMap<Config, Vec<Run>> = BTreeMap::new();
@@ -199,7 +126,7 @@ impl Results {
             groups,
             meshes,
             manifest,
-            skipped_lines,
+            torn_bytes,
         }
     }
 

@@ -3,6 +3,7 @@
 //! expected boxes), mesh pictures, and the `report` subcommand.
 
 use crate::util::{SEED, run_in};
+use quadrecomb::experiment::record::RunRecord;
 use quadrecomb::mesh::{Mesh, MeshData};
 use quadrecomb::quality::{CandidateTable, recombined};
 use quadrecomb::report::picture::{PictureOptions, mesh_svg};
@@ -167,7 +168,7 @@ const CONFIGS: [(&str, Option<u32>); 6] = [
     ("selective", Some(3)),
 ];
 
-/// One JSON line in the runner's `RunRecord` format.
+/// One line of `runs.jsonl`: a runner `RunRecord`.
 #[allow(clippy::too_many_arguments)]
 fn record(
     mesh: &str,
@@ -181,27 +182,27 @@ fn record(
     let triangles = 2104usize;
     let quads = (recombined_pct / 100.0 * triangles as f64 / 2.0).round() as usize;
     let decisions = quads as u64 + 3;
-    serde_json::json!({
-        "mesh": mesh,
-        "mesh_hash": "0123456789abcdef0123456789abcdef",
-        "triangles": triangles,
-        "algo": algo,
-        "horizon": horizon,
-        "seed": 1000 + u64::from(run),
-        "run": run,
-        "quads": quads,
-        "triangles_left": triangles - 2 * quads,
-        "recombined_pct": recombined_pct,
-        "quality": quality_pct * 9.5,
-        "quality_pct": quality_pct,
-        "time_s": time_s,
-        "nodes_expanded": decisions * u64::from(horizon.unwrap_or(1)) * 2,
-        "decisions": decisions,
-        "branching_factor": horizon.map(|_| 1.5),
-        "backend": "cpu-twin",
-        "version": "0.1.0",
-    })
-    .to_string()
+    RunRecord {
+        mesh: mesh.to_string(),
+        mesh_hash: "0123456789abcdef0123456789abcdef".to_string(),
+        triangles,
+        algo: algo.to_string(),
+        horizon,
+        seed: 1000 + u64::from(run),
+        run,
+        quads,
+        triangles_left: triangles - 2 * quads,
+        recombined_pct,
+        quality: quality_pct * 9.5,
+        quality_pct: Some(quality_pct),
+        time_s,
+        nodes_expanded: decisions * u64::from(horizon.unwrap_or(1)) * 2,
+        decisions,
+        branching_factor: horizon.filter(|&h| h >= 2).map(|_| 1.5),
+        backend: "cpu-twin".to_string(),
+        version: "0.1.0".to_string(),
+    }
+    .to_json_line()
 }
 
 /// Writes `runs.jsonl` for mesh "sphere": quality rises with the selective horizon, uniform h=2
@@ -235,6 +236,50 @@ fn synthetic_dir(dir: &Path, runs: u32, seed: u64, shift: f64) {
         }
     }
     std::fs::write(dir.join("runs.jsonl"), lines.join("\n") + "\n").unwrap();
+}
+
+/// Writes a manifest for the synthetic sphere sweep (optimum quality 950.0).
+fn synthetic_manifest(dir: &Path, runs: u32) {
+    use quadrecomb::experiment::manifest::{Machine, Manifest, MeshEntry, OptimumEntry, SweepSpec};
+    let hash = "0123456789abcdef0123456789abcdef".to_string();
+    Manifest {
+        version: "0.1.0".into(),
+        spec: SweepSpec {
+            meshes: vec![MeshEntry {
+                name: "sphere".into(),
+                source: "sphere".into(),
+                hash: hash.clone(),
+                triangles: 2104,
+            }],
+            algos: vec!["greedy".into(), "uniform".into(), "selective".into()],
+            horizons: vec![1, 2, 3],
+            runs,
+            baseline_runs: runs,
+            seed: SEED,
+        },
+        backend: "cpu-twin".into(),
+        backend_requested: "cpu".into(),
+        optimum: vec![OptimumEntry {
+            mesh: "sphere".into(),
+            mesh_hash: hash,
+            eta_hash: "e".into(),
+            quality: 950.0,
+            quads: 1052,
+            triangles_left: 0,
+            time_s: 0.5,
+        }],
+        shard: None,
+        threads: 2,
+        machine: Machine {
+            cpu: "Test CPU 9000".into(),
+            cores: 2,
+            os: "linux".into(),
+            host: "h".into(),
+        },
+        merged_from: Vec::new(),
+    }
+    .write(dir)
+    .unwrap();
 }
 
 /// Parses an SVG through usvg and renders it through resvg; returns the ids of its elements.
@@ -276,12 +321,22 @@ fn collect_ids(group: &resvg::usvg::Group, ids: &mut Vec<String>) {
 fn report_names_every_configuration_and_draws_every_box() {
     let tmp = tempfile::tempdir().unwrap();
     synthetic_dir(tmp.path(), 30, SEED, 0.0);
+    synthetic_manifest(tmp.path(), 30);
     let opts = ReportOptions {
         pictures: false,
         ..ReportOptions::default()
     };
     let paths = report::write(tmp.path(), &opts).unwrap();
     let md = std::fs::read_to_string(&paths.markdown).unwrap();
+    // The manifest's machine and optimum.
+    assert!(
+        md.contains("Machine: Test CPU 9000 (2 logical cores)"),
+        "{md}"
+    );
+    assert!(
+        md.contains("Optimum quality (maximum-weight matching): 950.0000"),
+        "{md}"
+    );
     let html = std::fs::read_to_string(&paths.html).unwrap();
     for (algo, h) in CONFIGS {
         let label = match h {
@@ -402,7 +457,10 @@ fn torn_last_line_is_skipped_and_other_bad_lines_are_errors() {
     // A bad line in the middle is an error naming the line.
     std::fs::write(&runs, format!("not json\n{text}")).unwrap();
     let err = report::write(tmp.path(), &opts).unwrap_err().to_string();
-    assert!(err.contains("runs.jsonl:1:"), "{err}");
+    assert!(
+        err.contains("runs.jsonl") && err.contains("line 1"),
+        "{err}"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
