@@ -2,4 +2,5 @@
 
 mod meshes;
 mod report;
+mod search;
 mod util;

@@ -1,0 +1,221 @@
+//! The policies: greedy without and with the criterion, the uniform look-ahead tree with
+//! exact branch and bound, and the selective look-ahead tree. All explore by apply / undo.
+
+use super::Searcher;
+use crate::mesh::NONE;
+use rand::Rng;
+
+/// Slack added to branch-and-bound upper bounds so that rounding never prunes a sequence
+/// whose value could tie or beat the best (keeps the result identical to exhaustive search).
+const BOUND_SLACK: f64 = 1e-9;
+
+impl Searcher<'_> {
+    /// Uniform pick in `0..n` (n > 0) from the run's ChaCha8 stream, portable.
+    fn pick(&mut self, n: usize) -> usize {
+        ((self.rng.next_u64() as u128 * n as u128) >> 64) as usize
+    }
+
+    /// Moves the cursor past candidates that are no longer live (permanent on the main
+    /// trajectory).
+    fn advance_cursor(&mut self) {
+        while self.cursor < self.order.len() && !self.state.is_live(self.order[self.cursor]) {
+            self.cursor += 1;
+        }
+    }
+
+    /// Decreasing eta, no criterion.
+    pub(super) fn greedy_nocrit(&mut self) -> Vec<u32> {
+        let table = self.state.table();
+        self.used.iter_mut().for_each(|u| *u = false);
+        let mut chosen = Vec::new();
+        for &c in &self.order {
+            let [a, b] = table.pairs[c as usize];
+            if !self.used[a as usize] && !self.used[b as usize] {
+                self.used[a as usize] = true;
+                self.used[b as usize] = true;
+                chosen.push(c);
+            }
+        }
+        chosen
+    }
+
+    /// Decreasing eta among allowed actions.
+    pub(super) fn greedy(&mut self) {
+        loop {
+            self.advance_cursor();
+            let next = self.order[self.cursor..]
+                .iter()
+                .copied()
+                .find(|&c| self.state.is_allowed(c));
+            match next {
+                Some(c) => self.state.apply(c),
+                None => break,
+            }
+        }
+    }
+
+    /// Uniform look-ahead tree of horizon `h` with exact branch and bound.
+    pub(super) fn uniform(&mut self, h: u32) {
+        loop {
+            self.advance_cursor();
+            if self.cursor == self.order.len() {
+                break;
+            }
+            // Rewards only fall as triangles are used: the best live eta bounds every step.
+            let top = self.state.table().eta[self.order[self.cursor] as usize];
+            let mut best = f64::NEG_INFINITY;
+            let mut first = NONE;
+            self.uniform_dfs(0, h, 0.0, top, NONE, &mut best, &mut first);
+            if first == NONE {
+                break;
+            }
+            self.state.apply(first);
+        }
+    }
+
+    /// Explores the node at depth `d` (partial reward `partial`, first action `root`);
+    /// children in decreasing eta, pruned when even `top` per remaining step cannot beat
+    /// `best` (strictly).
+    #[allow(clippy::too_many_arguments)]
+    fn uniform_dfs(
+        &mut self,
+        d: u32,
+        h: u32,
+        partial: f64,
+        top: f64,
+        root: u32,
+        best: &mut f64,
+        first: &mut u32,
+    ) {
+        let table = self.state.table();
+        let rest = (h - d - 1) as f64 * top;
+        let mut any = false;
+        let mut i = self.cursor;
+        let mut expanded = false;
+        while i < self.order.len() {
+            let c = self.order[i];
+            i += 1;
+            if !self.state.is_allowed(c) {
+                continue;
+            }
+            any = true;
+            let eta = table.eta[c as usize];
+            if partial + eta + rest + BOUND_SLACK <= *best {
+                break;
+            }
+            if !expanded {
+                expanded = true;
+                self.nodes += 1;
+            }
+            let r = if d == 0 { c } else { root };
+            if d + 1 == h {
+                let v = partial + eta;
+                if v > *best {
+                    *best = v;
+                    *first = r;
+                }
+            } else {
+                self.state.apply(c);
+                self.uniform_dfs(d + 1, h, partial + eta, top, r, best, first);
+                self.state.undo();
+            }
+        }
+        if !any && d > 0 && partial > *best {
+            // No action left: a shorter sequence is a leaf.
+            *best = partial;
+            *first = root;
+        }
+    }
+
+    /// Selective look-ahead tree of horizon `h`.
+    pub(super) fn selective(&mut self, h: u32) {
+        let table = self.state.table();
+        while let Some(k) = self.state.min_k() {
+            let n = self.state.bucket(k).len();
+            let i = self.pick(n);
+            let t = self.state.bucket(k)[i];
+            self.nodes += 1;
+            let mut best = f64::NEG_INFINITY;
+            let mut first = NONE;
+            for c in table.by_triangle[t as usize] {
+                if c == NONE || !self.state.is_allowed(c) {
+                    continue;
+                }
+                let v = table.eta[c as usize] + self.selective_child(c, 1, h);
+                if v > best {
+                    best = v;
+                    first = c;
+                }
+            }
+            debug_assert!(first != NONE, "a triangle of P_min has an allowed action");
+            self.state.apply(first);
+        }
+    }
+
+    /// Value of the best leaf below the child reached by action `c` at depth `d` (the reward
+    /// of `c` excluded).
+    fn selective_child(&mut self, c: u32, d: u32, h: u32) -> f64 {
+        if d == h {
+            return 0.0;
+        }
+        self.state.apply(c);
+        self.path.push(c);
+        let v = self.selective_node(d, h);
+        self.path.pop();
+        self.state.undo();
+        v
+    }
+
+    /// Best summed reward below the current node at depth `d < h`.
+    fn selective_node(&mut self, d: u32, h: u32) -> f64 {
+        let table = self.state.table();
+        let Some(t) = self.choose_triangle() else {
+            return 0.0;
+        };
+        self.nodes += 1;
+        let mut best = f64::NEG_INFINITY;
+        for c in table.by_triangle[t as usize] {
+            if c == NONE || !self.state.is_allowed(c) {
+                continue;
+            }
+            let v = table.eta[c as usize] + self.selective_child(c, d + 1, h);
+            if v > best {
+                best = v;
+            }
+        }
+        best
+    }
+
+    /// The triangle to branch on below the root: uniformly from the first non-empty
+    /// `P_k ∩ N` (N: recombinable triangles next to a quad of the path), else from `P_min`.
+    fn choose_triangle(&mut self) -> Option<u32> {
+        self.near.clear();
+        let mut kmin = u32::MAX;
+        for i in 0..self.path.len() {
+            for n in self.state.quad_neighbours(self.path[i]) {
+                if n == NONE {
+                    continue;
+                }
+                let k = self.state.allowed_count(n);
+                if k == 0 || k > kmin {
+                    continue;
+                }
+                if k < kmin {
+                    kmin = k;
+                    self.near.clear();
+                }
+                if !self.near.contains(&n) {
+                    self.near.push(n);
+                }
+            }
+        }
+        if !self.near.is_empty() {
+            let i = self.pick(self.near.len());
+            return Some(self.near[i]);
+        }
+        let k = self.state.min_k()?;
+        let n = self.state.bucket(k).len();
+        let i = self.pick(n);
+        Some(self.state.bucket(k)[i])
+    }
+}

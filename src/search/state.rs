@@ -1,0 +1,1076 @@
+//! The recombination state: remaining triangles, chosen quads, the running quality, and the
+//! exact set of allowed actions under the generalised polder criterion, with `apply` / `undo`
+//! through a change log (flat arrays, `u32` indices, nothing cloned).
+//!
+//! # The criterion
+//! Removing the two triangles of candidate `c` from their polder `P` (connected component of
+//! the dual graph of the remaining triangles) leaves up to four parts. The action is forbidden
+//! iff it increases the number of odd polders: with `|P|` even every part must be even, with
+//! `|P|` odd exactly one part may be odd. Both cases read "at most one odd part".
+//!
+//! # How it stays exact and fast
+//! * **Local proof.** Around each quad vertex `v` whose triangle fan is closed (interior,
+//!   manifold) and has no removed triangle, the two quad neighbours meeting at `v` are
+//!   connected through the fan. When these links connect every remaining neighbour, the
+//!   removal disconnects nothing and the action is allowed in O(1) (`dead_count[v] == 0`).
+//! * **Lockstep search** otherwise: one breadth-first search per group of neighbours, one
+//!   triangle per search per round; groups merge when they meet; it stops when all groups
+//!   met (one part) or all but one finished. Finished groups are whole parts (sizes known),
+//!   the last part's size is `|P| - 2 - (the others)`, so the cost is the smaller parts.
+//! * **Certificates.** A verdict stays valid while (a) the link vertices it may use keep no
+//!   removed triangle, (b) every triangle its search visited remains, and (c) for verdicts
+//!   that found a split, the parity of the polder holding the candidate is unchanged. So
+//!   applying an action rechecks only: the candidates at vertices whose fan just lost its
+//!   first triangle, the verdicts watching the two removed triangles, and, when a polder
+//!   changes parity (only an odd polder can split into parts of other parity), the split
+//!   verdicts in the parts that changed. Proof sketch in `docs/readme/search.md`.
+//! * Polder ids and sizes are kept per triangle; a split relabels only the finished
+//!   (smaller) parts the search already enumerated.
+//! * `P_k` buckets are arrays with position indices (O(1) move, uniform pick), restored to
+//!   the same order by `undo`, so runs are reproducible whatever the tree explored.
+
+#![allow(clippy::needless_range_loop)] // index loops over the 4 quad sides read best
+
+use crate::mesh::{Mesh, NONE};
+use crate::quality::CandidateTable;
+
+/// How a verdict was reached (what it depends on).
+const KIND_LOCAL: u8 = 0;
+/// The searches met: one part. Depends on the visited triangles.
+const KIND_MET: u8 = 1;
+/// A split was found. Depends on the visited triangles and the polder's parity.
+const KIND_SPLIT: u8 = 2;
+/// The quad touches removed regions in several places, all in distinct dead components:
+/// one part. Depends on those components staying distinct.
+const KIND_DISTINCT: u8 = 3;
+/// Owner mark for the two triangles being removed during a search.
+const BLOCKED: u8 = u8::MAX;
+
+/// One reversible change.
+#[derive(Debug, Clone, Copy)]
+enum Op {
+    /// Start of an `apply(c)`: undone last, revives the pair.
+    Apply(u32),
+    /// Previous verdict of a candidate.
+    Verdict {
+        c: u32,
+        ver: u32,
+        allowed: bool,
+        kind: u8,
+    },
+    /// Triangle `t` had `old` allowed actions, at position `pos` of bucket `old`.
+    Count { t: u32, old: u8, pos: u32 },
+    /// Triangle `t` was in polder `old`.
+    Polder { t: u32, old: u32 },
+    /// A polder id was created.
+    PolderNew,
+    /// Polder `p` had size `old`.
+    PolderSize { p: u32, old: u32 },
+    /// A watch entry was pushed onto triangle `t`'s list.
+    Watch(u32),
+    /// Candidate was pushed onto the split-verdict list.
+    SplitIns,
+    /// Candidate `c` was removed from position `pos` of the split-verdict list.
+    SplitRem { c: u32, pos: u32 },
+    /// Dead-component root `child` was attached under `root`.
+    Union { child: u32, root: u32 },
+    /// A watch entry was pushed onto dead-component root `v`'s list.
+    RootWatch(u32),
+}
+
+/// Result of one criterion check, with the parts the search enumerated left in scratch.
+#[derive(Debug, Clone, Copy)]
+struct Check {
+    allowed: bool,
+    kind: u8,
+}
+
+/// The recombination state. See the module docs.
+#[derive(Debug, Clone)]
+pub struct State<'a> {
+    mesh: &'a Mesh,
+    table: &'a CandidateTable,
+    // ---- static ----
+    /// Neighbours across the quad's edges `[s0-o1, o1-s1, s1-o0, o0-s0]`, or NONE.
+    cand_nb: Vec<[u32; 4]>,
+    /// Vertex fan is one closed cycle of triangles in the dual graph.
+    closed: Vec<bool>,
+    /// Candidates whose quad has vertex `v` (CSR).
+    vc_start: Vec<u32>,
+    vc_list: Vec<u32>,
+    // ---- dynamic ----
+    alive: Vec<bool>,
+    remaining: u32,
+    count: Vec<u8>,
+    bucket: [Vec<u32>; 4],
+    pos: Vec<u32>,
+    allowed: Vec<bool>,
+    kind: Vec<u8>,
+    cert_ver: Vec<u32>,
+    ver: u32,
+    dead_count: Vec<u32>,
+    polder: Vec<u32>,
+    polder_size: Vec<u32>,
+    watch: Vec<Vec<(u32, u32)>>,
+    /// Union-find (by size, no path compression, so it can be undone) over vertices: the
+    /// connected pieces of the removed region (used triangles, boundaries, input quads).
+    dsu_parent: Vec<u32>,
+    dsu_size: Vec<u32>,
+    /// Verdicts that rely on a dead-component root staying a root.
+    root_watch: Vec<Vec<(u32, u32)>>,
+    arc_roots: [u32; 4],
+    narcs: usize,
+    split: Vec<u32>,
+    split_pos: Vec<u32>,
+    chosen: Vec<u32>,
+    quality: Vec<f64>,
+    log: Vec<Op>,
+    // ---- scratch ----
+    stamp: Vec<u32>,
+    owner: Vec<u8>,
+    epoch: u32,
+    queue: [Vec<u32>; 4],
+    head: [usize; 4],
+    group: [u8; 4],
+    nsearch: usize,
+    cand_stamp: Vec<u32>,
+    cand_epoch: u32,
+    recheck: Vec<u32>,
+    changed: Vec<u32>,
+    moved: Vec<u32>,
+    /// Number of criterion checks that needed a search (statistics).
+    pub searches: u64,
+    /// Number of triangles those searches visited.
+    pub searched: u64,
+}
+
+impl<'a> State<'a> {
+    /// The initial state of `mesh` (every triangle remaining) with every verdict computed.
+    pub fn new(mesh: &'a Mesh, table: &'a CandidateTable) -> State<'a> {
+        let nt = mesh.num_triangles();
+        let nv = mesh.vertices.len();
+        let m = table.len();
+        let nb = &mesh.topology.neighbours;
+        let cand_nb: Vec<[u32; 4]> = (0..m)
+            .map(|c| {
+                let [t0, t1] = table.pairs[c];
+                let [s0, o1, s1, o0] = table.quads[c];
+                let across = |t: u32, a: u32, b: u32| {
+                    let tri = mesh.triangles[t as usize];
+                    (0..3)
+                        .find(|&i| {
+                            let (x, y) = (tri[i], tri[(i + 1) % 3]);
+                            (x == a && y == b) || (x == b && y == a)
+                        })
+                        .map_or(NONE, |i| nb[t as usize][i])
+                };
+                [
+                    across(t1, s0, o1),
+                    across(t1, o1, s1),
+                    across(t0, s1, o0),
+                    across(t0, o0, s0),
+                ]
+            })
+            .collect();
+        // Vertex fans: closed iff walking around v through the dual graph visits every
+        // incident triangle and comes back.
+        let mut vt_count = vec![0u32; nv];
+        let mut vt_first = vec![NONE; nv];
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for &v in tri {
+                vt_count[v as usize] += 1;
+                vt_first[v as usize] = t as u32;
+            }
+        }
+        let has_quad: Vec<bool> = {
+            let mut h = vec![false; nv];
+            for q in &mesh.quads {
+                for &v in q {
+                    h[v as usize] = true;
+                }
+            }
+            h
+        };
+        let closed: Vec<bool> = (0..nv)
+            .map(|v| {
+                let n = vt_count[v];
+                if n < 3 || has_quad[v] {
+                    return false;
+                }
+                let start = vt_first[v];
+                let (mut prev, mut cur) = (NONE, start);
+                for step in 0..n {
+                    let tri = mesh.triangles[cur as usize];
+                    let j = tri.iter().position(|&x| x == v as u32).expect("incident");
+                    let (a, b) = (nb[cur as usize][j], nb[cur as usize][(j + 2) % 3]);
+                    let next = if a != prev { a } else { b };
+                    if next == NONE || (step == 0 && a == NONE) {
+                        return false;
+                    }
+                    prev = cur;
+                    cur = next;
+                    if cur == start {
+                        return step + 1 == n;
+                    }
+                }
+                false
+            })
+            .collect();
+        let mut vc_start = vec![0u32; nv + 1];
+        for q in &table.quads {
+            for &v in q {
+                vc_start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..nv {
+            vc_start[v + 1] += vc_start[v];
+        }
+        let mut fill = vc_start.clone();
+        let mut vc_list = vec![0u32; vc_start[nv] as usize];
+        for (c, q) in table.quads.iter().enumerate() {
+            for &v in q {
+                vc_list[fill[v as usize] as usize] = c as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        let mut st = State {
+            mesh,
+            table,
+            cand_nb,
+            closed,
+            vc_start,
+            vc_list,
+            alive: vec![true; nt],
+            remaining: nt as u32,
+            count: vec![0; nt],
+            bucket: Default::default(),
+            pos: vec![NONE; nt],
+            allowed: vec![false; m],
+            kind: vec![KIND_LOCAL; m],
+            cert_ver: vec![0; m],
+            ver: 0,
+            dead_count: vec![0; nv],
+            polder: mesh.topology.component.clone(),
+            polder_size: mesh.topology.component_sizes.clone(),
+            watch: vec![Vec::new(); nt],
+            dsu_parent: (0..nv as u32).collect(),
+            dsu_size: vec![1; nv],
+            root_watch: vec![Vec::new(); nv],
+            arc_roots: [NONE; 4],
+            narcs: 0,
+            split: Vec::new(),
+            split_pos: vec![NONE; m],
+            chosen: Vec::new(),
+            quality: vec![0.0],
+            log: Vec::new(),
+            stamp: vec![0; nt],
+            owner: vec![0; nt],
+            epoch: 0,
+            queue: Default::default(),
+            head: [0; 4],
+            group: [0; 4],
+            nsearch: 0,
+            cand_stamp: vec![0; m],
+            cand_epoch: 0,
+            recheck: Vec::new(),
+            changed: Vec::new(),
+            moved: Vec::new(),
+            searches: 0,
+            searched: 0,
+        };
+        // The removed region at the start: boundary edges (mesh, surface and quad
+        // boundaries: dual sides without a neighbour) and input quads.
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for i in 0..3 {
+                if nb[t][i] == NONE {
+                    st.union(tri[i], tri[(i + 1) % 3]);
+                }
+            }
+        }
+        for q in &mesh.quads {
+            for i in 1..4 {
+                st.union(q[0], q[i]);
+            }
+        }
+        for c in 0..m as u32 {
+            st.recheck_one(c);
+        }
+        // The initial verdicts are the base state: nothing to undo before it.
+        st.log.clear();
+        st
+    }
+
+    /// The mesh this state recombines.
+    pub fn mesh(&self) -> &'a Mesh {
+        self.mesh
+    }
+
+    /// The candidate table.
+    pub fn table(&self) -> &'a CandidateTable {
+        self.table
+    }
+
+    /// True when candidate `c` may be applied now: both triangles remain and the criterion
+    /// allows it. Exact at any time.
+    #[inline]
+    pub fn is_allowed(&self, c: u32) -> bool {
+        self.allowed[c as usize]
+    }
+
+    /// Number of allowed actions of triangle `t` (the `k` of `P_k`); 0 for a used triangle.
+    #[inline]
+    pub fn allowed_count(&self, t: u32) -> u32 {
+        self.count[t as usize] as u32
+    }
+
+    /// True when triangle `t` is not yet part of a quad.
+    #[inline]
+    pub fn is_remaining(&self, t: u32) -> bool {
+        self.alive[t as usize]
+    }
+
+    /// Both triangles of `c` remain (whatever the criterion says).
+    #[inline]
+    pub fn is_live(&self, c: u32) -> bool {
+        let [a, b] = self.table.pairs[c as usize];
+        self.alive[a as usize] && self.alive[b as usize]
+    }
+
+    /// Every allowed action, in increasing candidate order (O(candidates); for tests).
+    pub fn allowed_actions(&self) -> Vec<u32> {
+        (0..self.table.len() as u32)
+            .filter(|&c| self.allowed[c as usize])
+            .collect()
+    }
+
+    /// Triangles with exactly `k` allowed actions (`P_k`, k in 1..=3), in bucket order.
+    #[inline]
+    pub fn bucket(&self, k: u32) -> &[u32] {
+        &self.bucket[k as usize]
+    }
+
+    /// The smallest `k` with `P_k` non-empty, or `None` when no action is allowed.
+    #[inline]
+    pub fn min_k(&self) -> Option<u32> {
+        (1..4)
+            .find(|&k| !self.bucket[k].is_empty())
+            .map(|k| k as u32)
+    }
+
+    /// Candidates applied so far, in order.
+    pub fn chosen(&self) -> &[u32] {
+        &self.chosen
+    }
+
+    /// Number of quads created.
+    pub fn quads(&self) -> usize {
+        self.chosen.len()
+    }
+
+    /// Number of remaining triangles.
+    pub fn triangles_left(&self) -> usize {
+        self.remaining as usize
+    }
+
+    /// Sum of eta over the quads created (eq. 2).
+    pub fn quality(&self) -> f64 {
+        *self.quality.last().expect("base quality")
+    }
+
+    /// Polder id of a remaining triangle.
+    pub fn polder_of(&self, t: u32) -> u32 {
+        self.polder[t as usize]
+    }
+
+    /// Size of polder `p`.
+    pub fn polder_size(&self, p: u32) -> u32 {
+        self.polder_size[p as usize]
+    }
+
+    /// The neighbours across the quad edges of candidate `c`, `NONE` where there is none.
+    #[inline]
+    pub fn quad_neighbours(&self, c: u32) -> [u32; 4] {
+        self.cand_nb[c as usize]
+    }
+
+    /// Number of applied actions that `undo` can revert.
+    pub fn depth(&self) -> usize {
+        self.chosen.len()
+    }
+
+    // ------------------------------------------------------------------------------------
+    // The criterion.
+
+    /// Checks candidate `c` (both triangles remaining) in the current state. Leaves the
+    /// searches' visited triangles in `queue[..nsearch]` and their groups in `group`.
+    fn check(&mut self, c: u32) -> Check {
+        let [t0, t1] = self.table.pairs[c as usize];
+        let n = self.cand_nb[c as usize];
+        let q = self.table.quads[c as usize];
+        let mut root = [0u8, 1, 2, 3];
+        fn find(r: &mut [u8; 4], mut i: u8) -> u8 {
+            while r[i as usize] != i {
+                i = r[i as usize];
+            }
+            i
+        }
+        let mut live = [false; 4];
+        for i in 0..4 {
+            live[i] = n[i] != NONE && self.alive[n[i] as usize];
+        }
+        for i in 0..4 {
+            if !live[i] {
+                continue;
+            }
+            for j in 0..i {
+                if live[j] && n[i] == n[j] {
+                    let (a, b) = (find(&mut root, i as u8), find(&mut root, j as u8));
+                    root[a as usize] = b;
+                }
+            }
+            let j = (i + 1) % 4;
+            let v = q[j] as usize;
+            if live[j] && self.closed[v] && self.dead_count[v] == 0 {
+                let (a, b) = (find(&mut root, i as u8), find(&mut root, j as u8));
+                root[a as usize] = b;
+            }
+        }
+        // Distinct groups of live neighbours: one search per group.
+        let mut sid = [u8::MAX; 4];
+        let mut ns = 0usize;
+        for i in 0..4 {
+            if live[i] {
+                let r = find(&mut root, i as u8) as usize;
+                if sid[r] == u8::MAX {
+                    sid[r] = ns as u8;
+                    ns += 1;
+                }
+            }
+        }
+        self.nsearch = 0;
+        if ns <= 1 {
+            return Check {
+                allowed: true,
+                kind: KIND_LOCAL,
+            };
+        }
+        // Where the quad touches the removed region: arcs of touched vertices joined by
+        // touched edges. A split needs one dead component to touch the quad twice.
+        let mut touched = [false; 4];
+        for i in 0..4 {
+            let v = q[i] as usize;
+            touched[i] = !self.closed[v] || self.dead_count[v] > 0;
+        }
+        self.narcs = 0;
+        let mut distinct = true;
+        for i in 0..4 {
+            let prev = (i + 3) % 4;
+            // Edge `prev` joins q[prev] and q[i]; touched when its neighbour is gone.
+            if touched[i] && (live[prev] || !touched[prev]) {
+                let r = self.find(q[i]);
+                if self.arc_roots[..self.narcs].contains(&r) {
+                    distinct = false;
+                    break;
+                }
+                self.arc_roots[self.narcs] = r;
+                self.narcs += 1;
+            }
+        }
+        if distinct && self.narcs > 0 {
+            return Check {
+                allowed: true,
+                kind: KIND_DISTINCT,
+            };
+        }
+        self.searches += 1;
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            self.stamp.iter_mut().for_each(|s| *s = 0);
+            self.epoch = 1;
+        }
+        let ep = self.epoch;
+        self.stamp[t0 as usize] = ep;
+        self.owner[t0 as usize] = BLOCKED;
+        self.stamp[t1 as usize] = ep;
+        self.owner[t1 as usize] = BLOCKED;
+        self.nsearch = ns;
+        for s in 0..ns {
+            self.queue[s].clear();
+            self.head[s] = 0;
+            self.group[s] = s as u8;
+        }
+        for i in 0..4 {
+            if live[i] {
+                let t = n[i] as usize;
+                if self.stamp[t] != ep {
+                    let s = sid[find(&mut root, i as u8) as usize];
+                    self.stamp[t] = ep;
+                    self.owner[t] = s;
+                    self.queue[s as usize].push(t as u32);
+                }
+            }
+        }
+        let nb = &self.mesh.topology.neighbours;
+        fn gfind(g: &[u8; 4], mut s: u8) -> u8 {
+            while g[s as usize] != s {
+                s = g[s as usize];
+            }
+            s
+        }
+        loop {
+            for s in 0..ns {
+                let h = self.head[s];
+                if h == self.queue[s].len() {
+                    continue;
+                }
+                let x = self.queue[s][h];
+                self.head[s] = h + 1;
+                for &u in &nb[x as usize] {
+                    if u == NONE || !self.alive[u as usize] {
+                        continue;
+                    }
+                    let ui = u as usize;
+                    if self.stamp[ui] != ep {
+                        self.stamp[ui] = ep;
+                        self.owner[ui] = s as u8;
+                        self.queue[s].push(u);
+                    } else {
+                        let o = self.owner[ui];
+                        if o != BLOCKED {
+                            let (a, b) = (gfind(&self.group, o), gfind(&self.group, s as u8));
+                            if a != b {
+                                self.group[a as usize] = b;
+                            }
+                        }
+                    }
+                }
+            }
+            // Groups and how many are still running.
+            let mut groups = 0;
+            let mut running = 0;
+            let mut gsize = [0u32; 4];
+            let mut gdone = [true; 4];
+            for s in 0..ns {
+                let g = gfind(&self.group, s as u8) as usize;
+                gsize[g] += self.queue[s].len() as u32;
+                if self.head[s] < self.queue[s].len() {
+                    gdone[g] = false;
+                }
+            }
+            for s in 0..ns {
+                if gfind(&self.group, s as u8) as usize == s {
+                    groups += 1;
+                    if !gdone[s] {
+                        running += 1;
+                    }
+                }
+            }
+            if groups == 1 {
+                self.count_searched(ns);
+                return Check {
+                    allowed: true,
+                    kind: KIND_MET,
+                };
+            }
+            if running <= 1 {
+                self.count_searched(ns);
+                let total = self.polder_size[self.polder[t0 as usize] as usize] - 2;
+                let mut odd = 0;
+                let mut known = 0;
+                for s in 0..ns {
+                    if gfind(&self.group, s as u8) as usize == s && gdone[s] {
+                        odd += gsize[s] & 1;
+                        known += gsize[s];
+                    }
+                }
+                if running == 1 {
+                    odd += (total - known) & 1;
+                } else {
+                    debug_assert_eq!(known, total, "parts add up to the polder");
+                }
+                for s in 0..ns {
+                    let g = gfind(&self.group, s as u8);
+                    self.group[s] = g;
+                }
+                return Check {
+                    allowed: odd <= 1,
+                    kind: KIND_SPLIT,
+                };
+            }
+        }
+    }
+
+    /// Root of vertex `v`'s dead component.
+    #[inline]
+    fn find(&self, mut v: u32) -> u32 {
+        while self.dsu_parent[v as usize] != v {
+            v = self.dsu_parent[v as usize];
+        }
+        v
+    }
+
+    /// Joins the dead components of `a` and `b` (logged); returns the root that was attached
+    /// under the other, if they were distinct.
+    fn union(&mut self, a: u32, b: u32) -> Option<u32> {
+        let (mut ra, mut rb) = (self.find(a), self.find(b));
+        if ra == rb {
+            return None;
+        }
+        if self.dsu_size[ra as usize] < self.dsu_size[rb as usize] {
+            std::mem::swap(&mut ra, &mut rb);
+        }
+        self.dsu_parent[rb as usize] = ra;
+        self.dsu_size[ra as usize] += self.dsu_size[rb as usize];
+        self.log.push(Op::Union {
+            child: rb,
+            root: ra,
+        });
+        Some(rb)
+    }
+
+    fn count_searched(&mut self, ns: usize) {
+        for s in 0..ns {
+            self.searched += self.queue[s].len() as u64;
+        }
+    }
+
+    /// Recomputes the verdict of live candidate `c` and records its certificate.
+    fn recheck_one(&mut self, c: u32) {
+        let r = self.check(c);
+        let ci = c as usize;
+        let old_kind = self.kind[ci];
+        let old_allowed = self.allowed[ci];
+        if r.kind == KIND_LOCAL && old_kind == KIND_LOCAL && r.allowed == old_allowed {
+            return;
+        }
+        self.log.push(Op::Verdict {
+            c,
+            ver: self.cert_ver[ci],
+            allowed: old_allowed,
+            kind: old_kind,
+        });
+        self.ver = self.ver.wrapping_add(1);
+        let ver = self.ver;
+        self.cert_ver[ci] = ver;
+        self.kind[ci] = r.kind;
+        if r.allowed != old_allowed {
+            self.allowed[ci] = r.allowed;
+            let [t0, t1] = self.table.pairs[ci];
+            for t in [t0, t1] {
+                let k = self.count[t as usize];
+                self.set_count(t, if r.allowed { k + 1 } else { k - 1 });
+            }
+        }
+        if r.kind == KIND_DISTINCT {
+            for i in 0..self.narcs {
+                let root = self.arc_roots[i];
+                self.root_watch[root as usize].push((c, ver));
+                self.log.push(Op::RootWatch(root));
+            }
+        } else if r.kind != KIND_LOCAL {
+            for s in 0..self.nsearch {
+                for i in 0..self.queue[s].len() {
+                    let t = self.queue[s][i];
+                    self.watch[t as usize].push((c, ver));
+                    self.log.push(Op::Watch(t));
+                }
+            }
+        }
+        let in_split = self.split_pos[ci] != NONE;
+        if r.kind == KIND_SPLIT && !in_split {
+            self.split_pos[ci] = self.split.len() as u32;
+            self.split.push(c);
+            self.log.push(Op::SplitIns);
+        } else if r.kind != KIND_SPLIT && in_split {
+            let p = self.split_pos[ci];
+            self.split.swap_remove(p as usize);
+            if let Some(&y) = self.split.get(p as usize) {
+                self.split_pos[y as usize] = p;
+            }
+            self.split_pos[ci] = NONE;
+            self.log.push(Op::SplitRem { c, pos: p });
+        }
+    }
+
+    /// Moves triangle `t` to bucket `new` (logged).
+    fn set_count(&mut self, t: u32, new: u8) {
+        let ti = t as usize;
+        let old = self.count[ti];
+        if old == new {
+            return;
+        }
+        let mut p = NONE;
+        if old > 0 {
+            p = self.pos[ti];
+            let b = &mut self.bucket[old as usize];
+            b.swap_remove(p as usize);
+            if let Some(&y) = b.get(p as usize) {
+                self.pos[y as usize] = p;
+            }
+        }
+        self.count[ti] = new;
+        if new > 0 {
+            let b = &mut self.bucket[new as usize];
+            self.pos[ti] = b.len() as u32;
+            b.push(t);
+        }
+        self.log.push(Op::Count { t, old, pos: p });
+    }
+
+    fn set_verdict_dead(&mut self, c: u32) {
+        let ci = c as usize;
+        self.log.push(Op::Verdict {
+            c,
+            ver: self.cert_ver[ci],
+            allowed: self.allowed[ci],
+            kind: self.kind[ci],
+        });
+        self.allowed[ci] = false;
+    }
+
+    fn mark(&mut self, c: u32) {
+        let ci = c as usize;
+        if self.cand_stamp[ci] != self.cand_epoch {
+            self.cand_stamp[ci] = self.cand_epoch;
+            self.recheck.push(c);
+        }
+    }
+
+    // ------------------------------------------------------------------------------------
+    // Apply and undo.
+
+    /// Recombines the two triangles of candidate `c` (both must remain; the criterion is
+    /// not required, and stays exact after a forbidden action too).
+    pub fn apply(&mut self, c: u32) {
+        let ci = c as usize;
+        let [t0, t1] = self.table.pairs[ci];
+        assert!(
+            self.is_live(c),
+            "apply({c}): a triangle of the pair is already used"
+        );
+        let r = self.check(c);
+        self.log.push(Op::Apply(c));
+        // Polder bookkeeping.
+        let p = self.polder[t0 as usize];
+        let psize = self.polder_size[p as usize];
+        self.changed.clear();
+        if r.kind == KIND_SPLIT {
+            let ns = self.nsearch;
+            // Whole parts found: each finished group; keep the old id for the running one,
+            // or for the largest when all finished.
+            let mut gsize = [0u32; 4];
+            let mut gdone = [true; 4];
+            for s in 0..ns {
+                let g = self.group[s] as usize;
+                gsize[g] += self.queue[s].len() as u32;
+                if self.head[s] < self.queue[s].len() {
+                    gdone[g] = false;
+                }
+            }
+            let mut keep = usize::MAX;
+            for g in 0..ns {
+                if self.group[g] as usize == g && !gdone[g] {
+                    keep = g;
+                }
+            }
+            if keep == usize::MAX {
+                for g in 0..ns {
+                    if self.group[g] as usize == g && (keep == usize::MAX || gsize[g] > gsize[keep])
+                    {
+                        keep = g;
+                    }
+                }
+            }
+            let mut known = 0;
+            for g in 0..ns {
+                if self.group[g] as usize != g || g == keep {
+                    continue;
+                }
+                let id = self.polder_size.len() as u32;
+                self.polder_size.push(gsize[g]);
+                self.log.push(Op::PolderNew);
+                known += gsize[g];
+                if gsize[g] % 2 != psize % 2 {
+                    self.changed.push(id);
+                }
+                for s in 0..ns {
+                    if self.group[s] as usize != g {
+                        continue;
+                    }
+                    for i in 0..self.queue[s].len() {
+                        let t = self.queue[s][i];
+                        self.log.push(Op::Polder { t, old: p });
+                        self.polder[t as usize] = id;
+                    }
+                }
+            }
+            let rest = psize - 2 - known;
+            if rest % 2 != psize % 2 {
+                self.changed.push(p);
+            }
+            self.log.push(Op::PolderSize { p, old: psize });
+            self.polder_size[p as usize] = rest;
+        } else {
+            self.log.push(Op::PolderSize { p, old: psize });
+            self.polder_size[p as usize] = psize - 2;
+        }
+        // Remove the pair.
+        self.alive[t0 as usize] = false;
+        self.alive[t1 as usize] = false;
+        self.remaining -= 2;
+        self.chosen.push(c);
+        let total = self.quality() + self.table.eta[ci];
+        self.quality.push(total);
+        for x in [t0, t1] {
+            self.set_count(x, 0);
+            for c2 in self.table.by_triangle[x as usize] {
+                if c2 != NONE && self.allowed[c2 as usize] {
+                    self.set_verdict_dead(c2);
+                    let u = self.table.other(c2, x);
+                    if self.alive[u as usize] {
+                        let k = self.count[u as usize];
+                        self.set_count(u, k - 1);
+                    }
+                }
+            }
+        }
+        // Vertices whose fan lost its first triangle: their links are gone.
+        self.cand_epoch = self.cand_epoch.wrapping_add(1);
+        if self.cand_epoch == 0 {
+            self.cand_stamp.iter_mut().for_each(|s| *s = 0);
+            self.cand_epoch = 1;
+        }
+        self.recheck.clear();
+        self.moved.clear();
+        for x in [t0, t1] {
+            for v in self.mesh.triangles[x as usize] {
+                let vi = v as usize;
+                if self.dead_count[vi] == 0 && self.closed[vi] {
+                    self.moved.push(v);
+                }
+                self.dead_count[vi] += 1;
+            }
+        }
+        // The quad joins the dead components at its four vertices.
+        let qv = self.table.quads[ci];
+        for i in 1..4 {
+            if let Some(child) = self.union(qv[0], qv[i]) {
+                for j in 0..self.root_watch[child as usize].len() {
+                    let (c2, ver) = self.root_watch[child as usize][j];
+                    if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
+                        self.mark(c2);
+                    }
+                }
+            }
+        }
+        for i in 0..self.moved.len() {
+            let v = self.moved[i] as usize;
+            for j in self.vc_start[v]..self.vc_start[v + 1] {
+                let c2 = self.vc_list[j as usize];
+                if self.is_live(c2) {
+                    self.mark(c2);
+                }
+            }
+        }
+        for x in [t0, t1] {
+            for i in 0..self.watch[x as usize].len() {
+                let (c2, ver) = self.watch[x as usize][i];
+                if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
+                    self.mark(c2);
+                }
+            }
+        }
+        if !self.changed.is_empty() {
+            for i in 0..self.split.len() {
+                let c2 = self.split[i];
+                if self.is_live(c2) {
+                    let pc = self.polder[self.table.pairs[c2 as usize][0] as usize];
+                    if self.changed.contains(&pc) {
+                        self.mark(c2);
+                    }
+                }
+            }
+        }
+        for i in 0..self.recheck.len() {
+            let c2 = self.recheck[i];
+            self.recheck_one(c2);
+        }
+    }
+
+    /// Reverts the last `apply`. Panics when nothing was applied.
+    pub fn undo(&mut self) {
+        assert!(!self.chosen.is_empty(), "undo with nothing applied");
+        while let Some(op) = self.log.pop() {
+            match op {
+                Op::Apply(c) => {
+                    let [t0, t1] = self.table.pairs[c as usize];
+                    for x in [t0, t1] {
+                        self.alive[x as usize] = true;
+                        for v in self.mesh.triangles[x as usize] {
+                            self.dead_count[v as usize] -= 1;
+                        }
+                    }
+                    self.remaining += 2;
+                    self.chosen.pop();
+                    self.quality.pop();
+                    return;
+                }
+                Op::Verdict {
+                    c,
+                    ver,
+                    allowed,
+                    kind,
+                } => {
+                    let ci = c as usize;
+                    self.cert_ver[ci] = ver;
+                    self.allowed[ci] = allowed;
+                    self.kind[ci] = kind;
+                }
+                Op::Count { t, old, pos } => {
+                    let ti = t as usize;
+                    let cur = self.count[ti];
+                    if cur > 0 {
+                        let x = self.bucket[cur as usize].pop();
+                        debug_assert_eq!(x, Some(t));
+                    }
+                    self.count[ti] = old;
+                    if old > 0 {
+                        let b = &mut self.bucket[old as usize];
+                        let p = pos as usize;
+                        if p == b.len() {
+                            b.push(t);
+                        } else {
+                            let y = b[p];
+                            b.push(y);
+                            self.pos[y as usize] = (b.len() - 1) as u32;
+                            b[p] = t;
+                        }
+                        self.pos[ti] = pos;
+                    }
+                }
+                Op::Polder { t, old } => self.polder[t as usize] = old,
+                Op::PolderNew => {
+                    self.polder_size.pop();
+                }
+                Op::PolderSize { p, old } => self.polder_size[p as usize] = old,
+                Op::Watch(t) => {
+                    self.watch[t as usize].pop();
+                }
+                Op::SplitIns => {
+                    let c = self.split.pop().expect("split entry");
+                    self.split_pos[c as usize] = NONE;
+                }
+                Op::Union { child, root } => {
+                    self.dsu_parent[child as usize] = child;
+                    self.dsu_size[root as usize] -= self.dsu_size[child as usize];
+                }
+                Op::RootWatch(v) => {
+                    self.root_watch[v as usize].pop();
+                }
+                Op::SplitRem { c, pos } => {
+                    let p = pos as usize;
+                    if p == self.split.len() {
+                        self.split.push(c);
+                    } else {
+                        let y = self.split[p];
+                        self.split.push(y);
+                        self.split_pos[y as usize] = (self.split.len() - 1) as u32;
+                        self.split[p] = c;
+                    }
+                    self.split_pos[c as usize] = pos;
+                }
+            }
+        }
+        unreachable!("undo log without an Apply marker");
+    }
+
+    /// Reverts every action applied.
+    pub fn reset(&mut self) {
+        while !self.chosen.is_empty() {
+            self.undo();
+        }
+    }
+
+    /// Checks the state's internal invariants (buckets, counts, polder sizes) and the
+    /// verdicts against a from-scratch evaluation of the criterion. O(n) per candidate:
+    /// for tests only.
+    pub fn sanity_check(&self) -> Result<(), String> {
+        let nt = self.alive.len();
+        for t in 0..nt {
+            let k = self.count[t];
+            let expect = if self.alive[t] {
+                self.table.by_triangle[t]
+                    .iter()
+                    .filter(|&&c| c != NONE && self.allowed[c as usize])
+                    .count() as u8
+            } else {
+                0
+            };
+            if k != expect {
+                return Err(format!("triangle {t}: count {k}, allowed actions {expect}"));
+            }
+            if k > 0 && self.bucket[k as usize][self.pos[t] as usize] != t as u32 {
+                return Err(format!("triangle {t}: bucket position wrong"));
+            }
+        }
+        for k in 1..4 {
+            for &t in &self.bucket[k] {
+                if self.count[t as usize] as usize != k {
+                    return Err(format!("triangle {t} in bucket {k}"));
+                }
+            }
+        }
+        let naive = naive_allowed(self.mesh, self.table, &self.alive);
+        for (c, &ok) in naive.iter().enumerate() {
+            if ok != self.allowed[c] {
+                return Err(format!(
+                    "candidate {c}: allowed {} but the naive criterion says {ok}",
+                    self.allowed[c]
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The criterion evaluated from scratch for every candidate (a full search from each
+/// neighbour of the pair, same rule: at most one odd part): the reference the fast state is
+/// tested against. `alive[t]` says which triangles remain.
+pub fn naive_allowed(mesh: &Mesh, table: &CandidateTable, alive: &[bool]) -> Vec<bool> {
+    let nb = &mesh.topology.neighbours;
+    let nt = alive.len();
+    let mut stack = Vec::new();
+    let mut mark = vec![0u32; nt];
+    let mut epoch = 0;
+    (0..table.len())
+        .map(|c| {
+            let [t0, t1] = table.pairs[c];
+            if !alive[t0 as usize] || !alive[t1 as usize] {
+                return false;
+            }
+            epoch += 1;
+            mark[t0 as usize] = epoch;
+            mark[t1 as usize] = epoch;
+            let mut odd = 0;
+            for &s in nb[t0 as usize].iter().chain(&nb[t1 as usize]) {
+                if s == NONE || !alive[s as usize] || mark[s as usize] == epoch {
+                    continue;
+                }
+                mark[s as usize] = epoch;
+                stack.push(s);
+                let mut size = 0u32;
+                while let Some(x) = stack.pop() {
+                    size += 1;
+                    for &u in &nb[x as usize] {
+                        if u != NONE && alive[u as usize] && mark[u as usize] != epoch {
+                            mark[u as usize] = epoch;
+                            stack.push(u);
+                        }
+                    }
+                }
+                odd += size & 1;
+            }
+            odd <= 1
+        })
+        .collect()
+}

@@ -1,0 +1,367 @@
+//! Search core: the state and its criterion (hand-checked cases, random apply/undo sequences
+//! against the naive criterion), the policies (reproducibility, exhaustive-search equality of
+//! the uniform tree), and the `recombine` CLI.
+
+use crate::util::SEED;
+use quadrecomb::mesh::{Mesh, MeshData, NONE};
+use quadrecomb::quality::CandidateTable;
+use quadrecomb::search::state::{State, naive_allowed};
+use quadrecomb::search::{self, Algo, Searcher};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// A strip of `n` triangles 0-1-...-(n-1), each sharing one edge with the next.
+fn strip(n: usize) -> Mesh {
+    let mut d = MeshData::default();
+    let cols = n / 2 + 2;
+    for i in 0..cols {
+        d.vertices.push([i as f64, 0.0, 0.0]);
+        d.vertices.push([i as f64 + 0.5, 1.0, 0.0]);
+    }
+    let (b, u) = (|i: usize| 2 * i as u32, |i: usize| 2 * i as u32 + 1);
+    for k in 0..n {
+        let i = k / 2;
+        d.triangles.push(if k % 2 == 0 {
+            [b(i), b(i + 1), u(i)]
+        } else {
+            [b(i + 1), u(i + 1), u(i)]
+        });
+    }
+    Mesh::new(d).expect("strip")
+}
+
+/// An `nx` x `ny` grid of unit squares, each split along the same diagonal, with optional
+/// jitter, triangles listed in `keep` order only where `keep(t)`, surfaces from `surface`.
+fn grid(
+    nx: usize,
+    ny: usize,
+    jitter: f64,
+    seed: u64,
+    keep: impl Fn(usize, usize) -> bool,
+    surface: impl Fn(usize, usize) -> i32,
+) -> Mesh {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut d = MeshData::default();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let mut jit = || (rng.next_u64() as f64 / u64::MAX as f64 - 0.5) * jitter;
+            let inner = i > 0 && j > 0 && i < nx && j < ny;
+            let (dx, dy) = if inner { (jit(), jit()) } else { (0.0, 0.0) };
+            d.vertices.push([i as f64 + dx, j as f64 + dy, 0.0]);
+        }
+    }
+    let v = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    for j in 0..ny {
+        for i in 0..nx {
+            if !keep(i, j) {
+                continue;
+            }
+            // Diagonal (i+1, j) - (i, j+1): the corner (0,0) is an ear.
+            d.triangles.push([v(i, j), v(i + 1, j), v(i, j + 1)]);
+            d.triangles
+                .push([v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)]);
+            d.triangle_surface.push(surface(i, j));
+            d.triangle_surface.push(surface(i, j));
+        }
+    }
+    Mesh::new(d).expect("grid")
+}
+
+fn pair_of(table: &CandidateTable, a: u32, b: u32) -> u32 {
+    (0..table.len() as u32)
+        .find(|&c| table.pairs[c as usize] == [a.min(b), a.max(b)])
+        .expect("neighbours")
+}
+
+#[test]
+fn strip_of_six_allows_only_even_splits() {
+    let mesh = strip(6);
+    let table = CandidateTable::build(&mesh);
+    let state = State::new(&mesh, &table);
+    for (a, b, ok) in [
+        (0, 1, true),
+        (1, 2, false),
+        (2, 3, true),
+        (3, 4, false),
+        (4, 5, true),
+    ] {
+        assert_eq!(state.is_allowed(pair_of(&table, a, b)), ok, "({a},{b})");
+    }
+    assert_eq!(state.allowed_count(0), 1);
+    assert_eq!(state.allowed_count(1), 1);
+    assert_eq!(state.allowed_count(2), 1);
+    state.sanity_check().unwrap();
+}
+
+#[test]
+fn strip_of_five_allows_everything() {
+    let mesh = strip(5);
+    let table = CandidateTable::build(&mesh);
+    let mut state = State::new(&mesh, &table);
+    assert_eq!(state.allowed_actions().len(), 4);
+    for t in 0..5 {
+        assert_eq!(state.allowed_count(t), if t == 0 || t == 4 { 1 } else { 2 });
+    }
+    // (1,2) leaves {0} and {3,4}: one odd part, allowed; then only (3,4) remains.
+    state.apply(pair_of(&table, 1, 2));
+    state.sanity_check().unwrap();
+    assert_eq!(state.allowed_actions(), vec![pair_of(&table, 3, 4)]);
+    assert_eq!(state.allowed_count(0), 0);
+    assert!(!state.is_remaining(1));
+    state.undo();
+    assert_eq!(state.allowed_actions().len(), 4);
+    state.sanity_check().unwrap();
+}
+
+#[test]
+fn grid_forbids_exactly_the_actions_isolating_an_ear() {
+    let mesh = grid(4, 4, 0.0, 0, |_, _| true, |_, _| 1);
+    assert_eq!(mesh.num_triangles(), 32);
+    let table = CandidateTable::build(&mesh);
+    let state = State::new(&mesh, &table);
+    state.sanity_check().unwrap();
+    // Ears: triangles with two boundary sides, and the pair of actions that cut them off.
+    let nb = &mesh.topology.neighbours;
+    let mut expect = Vec::new();
+    for t in 0..32u32 {
+        let inner: Vec<u32> = nb[t as usize]
+            .iter()
+            .copied()
+            .filter(|&u| u != NONE)
+            .collect();
+        if inner.len() == 1 {
+            let b = inner[0];
+            for &x in &nb[b as usize] {
+                if x != NONE && x != t {
+                    expect.push(pair_of(&table, b, x));
+                }
+            }
+        }
+    }
+    expect.sort_unstable();
+    assert_eq!(
+        expect.len(),
+        4,
+        "two ears (corners (0,0) and (4,4)), two cutting actions each"
+    );
+    let forbidden: Vec<u32> = (0..table.len() as u32)
+        .filter(|&c| !state.is_allowed(c))
+        .collect();
+    assert_eq!(forbidden, expect);
+}
+
+/// Random apply / undo sequences, checking every verdict against the naive criterion.
+fn random_walks(mesh: &Mesh, walks: usize, seed: u64) {
+    let table = CandidateTable::build(mesh);
+    let mut state = State::new(mesh, &table);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let initial = state.allowed_actions();
+    for _ in 0..walks {
+        loop {
+            let actions = state.allowed_actions();
+            if actions.is_empty() {
+                break;
+            }
+            // Mostly forward, sometimes back a step (tree-like exploration).
+            if state.depth() > 0 && rng.next_u64() % 5 == 0 {
+                state.undo();
+            } else {
+                let c = actions[(rng.next_u64() % actions.len() as u64) as usize];
+                state.apply(c);
+            }
+            state.sanity_check().unwrap();
+        }
+        let left = state.triangles_left();
+        assert_eq!(left + 2 * state.quads(), mesh.num_triangles());
+        state.reset();
+        assert_eq!(state.allowed_actions(), initial);
+    }
+}
+
+#[test]
+fn random_walks_match_the_naive_criterion_on_a_jittered_grid() {
+    random_walks(&grid(8, 7, 0.4, SEED, |_, _| true, |_, _| 1), 6, SEED);
+}
+
+#[test]
+fn random_walks_match_on_holes_surfaces_and_odd_components() {
+    // Holes (missing squares), two surfaces, and an odd component (a lone triangle is made
+    // by removing one triangle of a square: here a whole odd surface strip).
+    let holes = grid(
+        9,
+        8,
+        0.3,
+        SEED + 1,
+        |i, j| !(((3..5).contains(&i) && (3..5).contains(&j)) || (i == 7 && j == 1)),
+        |i, _| if i < 5 { 1 } else { 2 },
+    );
+    random_walks(&holes, 5, SEED + 1);
+    // Odd components: a strip of 5 and a strip of 7 side by side with a grid.
+    let mut d = MeshData::default();
+    for (k, m) in [
+        strip(5),
+        strip(7),
+        grid(5, 4, 0.3, SEED, |_, _| true, |_, _| 1),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let base = d.vertices.len() as u32;
+        for p in &m.vertices {
+            d.vertices.push([p[0], p[1] + 10.0 * k as f64, 0.0]);
+        }
+        for t in &m.triangles {
+            d.triangles.push(t.map(|v| v + base));
+        }
+    }
+    let odd = Mesh::new(d).unwrap();
+    assert!(odd.topology.component_sizes.iter().any(|s| s % 2 == 1));
+    random_walks(&odd, 8, SEED + 2);
+}
+
+#[test]
+fn naive_criterion_agrees_with_the_hand_checked_strip() {
+    let mesh = strip(6);
+    let table = CandidateTable::build(&mesh);
+    let ok = naive_allowed(&mesh, &table, &[true; 6]);
+    assert_eq!(ok, vec![true, false, true, false, true]);
+}
+
+/// Plain exhaustive uniform tree: best value of `h`-action sequences, first action, with the
+/// same order (decreasing eta, then index) and strict improvement.
+fn exhaustive(
+    state: &mut State<'_>,
+    order: &[u32],
+    h: u32,
+    partial: f64,
+    best: &mut (f64, u32),
+    root: u32,
+) {
+    let eta = &state.table().eta;
+    let mut any = false;
+    for &c in order {
+        if !state.is_allowed(c) {
+            continue;
+        }
+        any = true;
+        let r = if root == NONE { c } else { root };
+        let v = partial + eta[c as usize];
+        if h == 1 {
+            if v > best.0 {
+                *best = (v, r);
+            }
+        } else {
+            state.apply(c);
+            exhaustive(state, order, h - 1, v, best, r);
+            state.undo();
+        }
+    }
+    if !any && root != NONE && partial > best.0 {
+        *best = (partial, root);
+    }
+}
+
+#[test]
+fn uniform_tree_equals_exhaustive_search() {
+    for (mesh, h) in [
+        (grid(4, 3, 0.45, SEED, |_, _| true, |_, _| 1), 3),
+        (grid(3, 3, 0.3, SEED + 5, |i, j| i + j != 2, |_, _| 1), 4),
+        (strip(9), 3),
+    ] {
+        let table = CandidateTable::build(&mesh);
+        let mut order: Vec<u32> = (0..table.len() as u32).collect();
+        order.sort_by(|&a, &b| {
+            table.eta[b as usize]
+                .total_cmp(&table.eta[a as usize])
+                .then(a.cmp(&b))
+        });
+        // Replay the uniform run and check each decision against exhaustive search.
+        let out = search::run(&mesh, &table, Algo::Uniform { horizon: h }, SEED);
+        let mut state = State::new(&mesh, &table);
+        for &c in &out.chosen {
+            let mut best = (f64::NEG_INFINITY, NONE);
+            exhaustive(&mut state, &order, h, 0.0, &mut best, NONE);
+            assert_eq!(best.1, c, "uniform h={h} chose {c}, exhaustive {}", best.1);
+            state.apply(c);
+        }
+        assert!(
+            state.allowed_actions().is_empty(),
+            "the run stops only when stuck"
+        );
+    }
+}
+
+#[test]
+fn runs_are_reproducible_and_searchers_reusable() {
+    let mesh = grid(12, 10, 0.4, SEED, |_, _| true, |_, _| 1);
+    let table = CandidateTable::build(&mesh);
+    let mut s = Searcher::new(&mesh, &table);
+    for algo in [
+        Algo::GreedyNocrit,
+        Algo::Greedy,
+        Algo::Uniform { horizon: 2 },
+        Algo::Selective { horizon: 1 },
+        Algo::Selective { horizon: 4 },
+    ] {
+        let a = s.run(algo, SEED);
+        let b = s.run(algo, SEED);
+        let c = search::run(&mesh, &table, algo, SEED);
+        assert_eq!(a.chosen, b.chosen, "{algo}");
+        assert_eq!(a.chosen, c.chosen, "{algo}");
+        assert_eq!(a.quads + a.triangles_left / 2, mesh.num_triangles() / 2);
+        let q: f64 = a.chosen.iter().map(|&c| table.eta[c as usize]).sum();
+        assert!((q - a.quality).abs() < 1e-9);
+        // A matching: no triangle twice.
+        let mut used = vec![false; mesh.num_triangles()];
+        for &c in &a.chosen {
+            for t in table.pairs[c as usize] {
+                assert!(!used[t as usize]);
+                used[t as usize] = true;
+            }
+        }
+    }
+    // Different seeds explore differently on the selective tree.
+    let runs: Vec<_> = (0..6)
+        .map(|k| s.run(Algo::Selective { horizon: 2 }, k).chosen)
+        .collect();
+    assert!(runs.iter().any(|r| r != &runs[0]));
+}
+
+#[test]
+fn policies_respect_the_criterion_and_recombine_a_grid_fully() {
+    let mesh = grid(10, 10, 0.2, SEED, |_, _| true, |_, _| 1);
+    let table = CandidateTable::build(&mesh);
+    let mut s = Searcher::new(&mesh, &table);
+    for algo in [
+        Algo::Greedy,
+        Algo::Selective { horizon: 3 },
+        Algo::Uniform { horizon: 2 },
+    ] {
+        let out = s.run(algo, SEED);
+        // Replaying: every action was allowed when taken.
+        let mut state = State::new(&mesh, &table);
+        for &c in &out.chosen {
+            assert!(state.is_allowed(c), "{algo}: action {c} was forbidden");
+            state.apply(c);
+        }
+        assert!(state.allowed_actions().is_empty());
+        // The criterion keeps every polder even: an even grid ends fully recombined.
+        assert_eq!(out.triangles_left, 0, "{algo}");
+        assert!(out.nodes_expanded >= out.decisions);
+    }
+    // Without the criterion, greedy strands triangles on this mesh.
+    let nocrit = s.run(Algo::GreedyNocrit, SEED);
+    assert!(nocrit.quads > 0);
+}
+
+#[test]
+fn algo_names_parse() {
+    assert_eq!("greedy-nocrit".parse::<Algo>().unwrap(), Algo::GreedyNocrit);
+    assert_eq!(
+        "selective:5".parse::<Algo>().unwrap(),
+        Algo::Selective { horizon: 5 }
+    );
+    assert_eq!(Algo::Uniform { horizon: 2 }.to_string(), "uniform");
+    assert!("blossom".parse::<Algo>().is_err());
+    assert!("uniform:0".parse::<Algo>().is_err());
+}
