@@ -15,6 +15,10 @@ pub struct Args {
     /// Also draw the mesh pictures zoomed into this window (picture coordinates).
     #[arg(long, value_name = "x0,y0,x1,y1")]
     zoom: Option<String>,
+    /// Picture the typical run of this configuration, e.g. `selective:5` or `greedy`
+    /// (repeatable; default: greedy and the best horizon of each look-ahead algorithm).
+    #[arg(long = "picture", value_name = "ALGO[:H]")]
+    pictures: Vec<String>,
     /// Leave out the mesh pictures (they re-run each typical run).
     #[arg(long)]
     no_pictures: bool,
@@ -43,12 +47,33 @@ fn parse_zoom(s: &str) -> Result<[f64; 4], BadInput> {
     }
 }
 
+/// Parses "algo" or "algo:h".
+fn parse_picture(s: &str) -> Result<(String, Option<u32>), BadInput> {
+    match s.split_once(':') {
+        None => Ok((s.to_string(), None)),
+        Some((a, h)) => h
+            .parse::<u32>()
+            .map(|h| (a.to_string(), Some(h)))
+            .map_err(|_| {
+                BadInput(format!(
+                    "bad --picture {s:?}: expected ALGO or ALGO:H, e.g. selective:5"
+                ))
+            }),
+    }
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let zoom = args.zoom.as_deref().map(parse_zoom).transpose()?;
+    let picture_configs = args
+        .pictures
+        .iter()
+        .map(|s| parse_picture(s))
+        .collect::<Result<Vec<_>, _>>()?;
     let opts = ReportOptions {
         compare: args.compare,
         zoom,
         pictures: !args.no_pictures,
+        picture_configs,
         seed: args.seed,
     };
     let paths = report::write(&args.dir, &opts).map_err(|e| match e {

@@ -117,7 +117,10 @@ impl Document {
                     out.push('\n');
                 }
                 Block::Figure { file, caption, .. } => {
-                    out.push_str(&format!("![{}]({})\n\n", caption.replace(']', ")"), file));
+                    let alt = std::path::Path::new(file)
+                        .file_stem()
+                        .map_or(file.clone(), |s| s.to_string_lossy().into_owned());
+                    out.push_str(&format!("![{alt}]({file})\n\n"));
                     out.push_str(&format!("*{caption}*\n\n"));
                 }
             }

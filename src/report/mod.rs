@@ -15,6 +15,7 @@ pub mod picture;
 pub mod plots;
 pub mod results;
 pub mod significance;
+pub mod typical;
 
 pub use document::{Block, Document};
 pub use results::{Config, Metric, Results, Run};
@@ -59,6 +60,9 @@ pub struct ReportOptions {
     pub zoom: Option<[f64; 4]>,
     /// Draw mesh pictures of typical runs (re-running them).
     pub pictures: bool,
+    /// Configurations (algorithm, horizon) whose typical run is pictured; empty: greedy and,
+    /// per look-ahead algorithm, the horizon with the best median quality.
+    pub picture_configs: Vec<(String, Option<u32>)>,
     /// Seed of the bootstrap resampling.
     pub seed: u64,
 }
@@ -69,6 +73,7 @@ impl Default for ReportOptions {
             compare: None,
             zoom: None,
             pictures: true,
+            picture_configs: Vec::new(),
             seed: 0x5EED_2026,
         }
     }
@@ -129,6 +134,7 @@ pub fn build(
     let mut doc = Document::default();
     doc.heading(1, format!("quadrecomb report: {}", results.dir.display()));
     overview(&mut doc, results);
+    let mut rerunner = typical::Rerunner::default();
     for (i, mesh) in results.meshes.iter().enumerate() {
         mesh_section(
             &mut doc,
@@ -136,6 +142,7 @@ pub fn build(
             mesh,
             opts,
             opts.seed.wrapping_add(100_000 * i as u64),
+            &mut rerunner,
         )?;
     }
     if let Some(other) = other {
@@ -243,6 +250,7 @@ fn mesh_section(
     mesh: &str,
     opts: &ReportOptions,
     seed: u64,
+    rerunner: &mut typical::Rerunner,
 ) -> Result<(), ReportError> {
     let configs: Vec<(&Config, &[Run])> = results.configs_of(mesh).collect();
     let first = &configs[0].1[0];
@@ -299,7 +307,9 @@ fn mesh_section(
 
     paper_beside(doc, mesh, &configs);
     box_plots(doc, mesh, &configs)?;
-    let _ = opts;
+    if opts.pictures {
+        pictures(doc, results, mesh, &configs, opts, rerunner)?;
+    }
 
     doc.heading(3, "Statistical comparisons");
     let mut families: Vec<Family> = significance::consecutive_horizons(&configs, seed);
@@ -456,6 +466,112 @@ fn box_plots(
                 slug(mesh),
                 slug(algo),
                 metric.key()
+            );
+            doc.figure(file, svg, caption);
+        }
+    }
+    Ok(())
+}
+
+/// The configurations whose typical run is pictured.
+fn picture_choice<'a>(
+    configs: &[(&'a Config, &'a [Run])],
+    opts: &ReportOptions,
+) -> Vec<(&'a Config, &'a [Run])> {
+    if !opts.picture_configs.is_empty() {
+        return configs
+            .iter()
+            .filter(|(c, _)| {
+                opts.picture_configs
+                    .iter()
+                    .any(|(a, h)| *a == c.algo && (h.is_none() || *h == c.horizon))
+            })
+            .copied()
+            .collect();
+    }
+    let mut out: Vec<(&Config, &[Run])> = configs
+        .iter()
+        .filter(|(c, _)| c.algo == "greedy")
+        .copied()
+        .collect();
+    let mut algos: Vec<&str> = configs
+        .iter()
+        .filter(|(c, _)| c.horizon.is_some())
+        .map(|(c, _)| c.algo.as_str())
+        .collect();
+    algos.dedup();
+    for algo in algos {
+        let best = configs
+            .iter()
+            .filter(|(c, _)| c.algo == algo)
+            .max_by(|a, b| {
+                median(&Metric::Quality.values(a.1))
+                    .total_cmp(&median(&Metric::Quality.values(b.1)))
+            });
+        out.extend(best.copied());
+    }
+    out
+}
+
+/// Pictures of typical (median-quality) runs, re-run from their seeds.
+fn pictures(
+    doc: &mut Document,
+    results: &Results,
+    mesh: &str,
+    configs: &[(&Config, &[Run])],
+    opts: &ReportOptions,
+    rerunner: &mut typical::Rerunner,
+) -> Result<(), ReportError> {
+    let chosen = picture_choice(configs, opts);
+    if chosen.is_empty() {
+        return Ok(());
+    }
+    doc.heading(3, "Typical runs");
+    for (c, runs) in chosen {
+        if c.algo == "optimum" {
+            continue;
+        }
+        let Some(run) = typical::median_run(runs) else {
+            continue;
+        };
+        let t = match rerunner.rerun(results, run) {
+            Ok(t) => t,
+            Err(why) => {
+                doc.para(format!("No picture of {mesh} {}: {why}.", c.label()));
+                continue;
+            }
+        };
+        let mut views = vec![(None, "mesh")];
+        if let Some(z) = opts.zoom {
+            views.push((Some(z), "zoom"));
+        }
+        for (zoom, kind) in views {
+            let popts = picture::PictureOptions {
+                title: format!(
+                    "{mesh}: {}, typical run{}",
+                    c.label(),
+                    if zoom.is_some() { " (zoom)" } else { "" }
+                ),
+                zoom,
+                ..picture::PictureOptions::default()
+            };
+            let (svg, counts) = picture::mesh_svg(t.mesh, &t.rec, &popts)?;
+            let mut caption = format!(
+                "{mesh}: {} Quads coloured by eta (colour bar), leftover triangles in red; \
+                 {} quads and {} leftover triangles drawn",
+                t.note, counts.quads, counts.leftover
+            );
+            if counts.culled > 0 {
+                caption.push_str(&format!(", {} back faces culled", counts.culled));
+            }
+            if let Some([x0, y0, x1, y1]) = zoom {
+                caption.push_str(&format!(", window x {x0}..{x1}, y {y0}..{y1}"));
+            }
+            caption.push('.');
+            let file = format!(
+                "{FIGURES_DIR}/{}-{}-{kind}.svg",
+                slug(mesh),
+                slug(&c.label())
             );
             doc.figure(file, svg, caption);
         }
