@@ -302,7 +302,8 @@ fn mesh_section(
         "Medians over the runs of each configuration. Quality is the sum of eta over the quads as \
          a percentage of the optimum; recombined is the percentage of triangles merged into \
          quads; time is the search's wall time; nodes per step is tree nodes expanded per \
-         decision; the branching factor is the b with b + b^2 + ... + b^h = nodes per step.",
+         decision; the branching factor is the runner's effective branching factor, the b with \
+         1 + b + ... + b^(h-1) = nodes per step (none at h = 1).",
     );
 
     paper_beside(doc, mesh, &configs);
@@ -364,11 +365,11 @@ fn paper_beside(doc: &mut Document, mesh: &str, configs: &[(&Config, &[Run])]) {
             p.algo.to_string(),
             p.horizon.map_or("–".into(), |h| h.to_string()),
             fmt_opt(ours_med(Metric::Quality), 2),
-            fmt_opt(p.quality_pct, 2),
+            paper_number(p.quality_pct),
             fmt_opt(ours_med(Metric::Recombined), 2),
-            fmt_opt(p.recombined_pct, 2),
+            paper_number(p.recombined_pct),
             ours_med(Metric::Time).map_or("–".into(), |t| fmt_sig(t, 3)),
-            p.time_s.map_or("–".into(), |t| fmt_sig(t, 3)),
+            paper_number(p.time_s),
             p.source.to_string(),
         ]);
     }
@@ -389,6 +390,11 @@ fn paper_beside(doc: &mut Document, mesh: &str, configs: &[(&Config, &[Run])]) {
         rows,
     );
     doc.list(case.notes.iter().map(|n| format!("Paper: {n}")).collect());
+}
+
+/// A number of the paper as printed there (at most two decimals), or "–".
+fn paper_number(v: Option<f64>) -> String {
+    v.map_or("–".into(), |v| format!("{}", (v * 100.0).round() / 100.0))
 }
 
 /// Fig.-8-style box plots for each algorithm with horizons.
