@@ -4,6 +4,7 @@ mod gpu;
 mod io;
 mod meshes;
 mod optimum;
+mod report;
 mod runner;
 mod search;
 mod search_oracle;
