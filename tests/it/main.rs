@@ -1,4 +1,5 @@
 //! The one integration-test binary: each module tests one area through the library or the CLI.
 
 mod io;
+mod meshes;
 mod util;
