@@ -618,6 +618,10 @@ fn evaluator_fills_tables_of_many_meshes_on_each_backend() {
         assert!(e.name().starts_with("vulkan: "));
         evaluators.push(e);
     }
+    if dev().is_none() {
+        let err = Evaluator::new(Backend::Gpu).unwrap_err();
+        assert!(matches!(err, gpu::GpuError::NoAdapter), "{err}");
+    }
     let auto = Evaluator::new(Backend::Auto).unwrap();
     assert_eq!(
         auto.is_device(),
