@@ -405,9 +405,14 @@ fn bad(name: &str) -> PathBuf {
 
 #[test]
 fn bad_input_missing_file() {
-    assert_bad(
+    let err = assert_bad(
         Path::new("/nonexistent/dir/no_such_mesh.msh"),
         &["No such file"],
+    );
+    assert_eq!(
+        err.matches("No such file").count(),
+        1,
+        "cause repeated: {err}"
     );
 }
 
