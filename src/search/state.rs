@@ -841,7 +841,18 @@ impl<'a> State<'a> {
             self.is_live(c),
             "apply({c}): a triangle of the pair is already used"
         );
-        let r = self.check(c);
+        // An exact verdict that found one part needs no new search; a split does (its
+        // parts are relabelled).
+        let known = !self.dirty[ci] && self.allowed[ci] && self.kind[ci] != KIND_SPLIT;
+        let r = if known {
+            self.nsearch = 0;
+            Check {
+                allowed: true,
+                kind: self.kind[ci],
+            }
+        } else {
+            self.check(c)
+        };
         self.log.push(Op::Apply(c));
         // Polder bookkeeping.
         let p = self.polder[t0 as usize];
