@@ -802,6 +802,12 @@ impl<'a> State<'a> {
         }
     }
 
+    /// Candidates marked stale since the list was last emptied (from position `from`):
+    /// lets greedy revisit exactly the actions whose verdict may have changed.
+    pub(crate) fn dirty_since(&self, from: usize) -> &[u32] {
+        &self.dirty_list[from.min(self.dirty_list.len())..]
+    }
+
     /// Exact allowed-ness inside a lazy tree (rechecks `c` first if needed).
     #[inline]
     pub(crate) fn is_allowed_lazy(&mut self, c: u32) -> bool {
