@@ -39,17 +39,46 @@ impl Searcher<'_> {
         chosen
     }
 
-    /// Decreasing eta among allowed actions.
+    /// Decreasing eta among allowed actions. The cursor passes used and forbidden actions
+    /// for good; an action behind it is looked at again only when an action marked its
+    /// verdict stale, so each step costs what changed, not a rescan.
     pub(super) fn greedy(&mut self) {
+        self.revisit.clear();
+        let mut seen = self.state.dirty_since(0).len();
         loop {
-            self.advance_cursor();
-            let next = self.order[self.cursor..]
-                .iter()
-                .copied()
-                .find(|&c| self.state.is_allowed(c));
-            match next {
-                Some(c) => self.state.apply(c),
-                None => break,
+            let mut next = NONE;
+            while let Some(&std::cmp::Reverse(r)) = self.revisit.peek() {
+                self.revisit.pop();
+                let c = self.order[r as usize];
+                if self.state.is_allowed_lazy(c) {
+                    next = c;
+                    break;
+                }
+            }
+            if next == NONE {
+                while self.cursor < self.order.len() {
+                    let c = self.order[self.cursor];
+                    self.cursor += 1;
+                    if self.state.is_allowed_lazy(c) {
+                        next = c;
+                        break;
+                    }
+                }
+            } else {
+                // A revisited action wins only if it comes before everything ahead.
+                debug_assert!((self.rank[next as usize] as usize) < self.cursor);
+            }
+            if next == NONE {
+                break;
+            }
+            self.state.apply_lazy(next);
+            let fresh = self.state.dirty_since(seen);
+            seen += fresh.len();
+            for &c in fresh {
+                let r = self.rank[c as usize];
+                if (r as usize) < self.cursor {
+                    self.revisit.push(std::cmp::Reverse(r));
+                }
             }
         }
     }
@@ -69,7 +98,7 @@ impl Searcher<'_> {
             if first == NONE {
                 break;
             }
-            self.state.apply(first);
+            self.state.apply_lazy(first);
         }
     }
 
@@ -95,7 +124,7 @@ impl Searcher<'_> {
         while i < self.order.len() {
             let c = self.order[i];
             i += 1;
-            if !self.state.is_allowed(c) {
+            if !self.state.is_allowed_lazy(c) {
                 continue;
             }
             any = true;
@@ -115,7 +144,7 @@ impl Searcher<'_> {
                     *first = r;
                 }
             } else {
-                self.state.apply(c);
+                self.state.apply_lazy(c);
                 self.uniform_dfs(d + 1, h, partial + eta, top, r, best, first);
                 self.state.undo();
             }
@@ -158,7 +187,7 @@ impl Searcher<'_> {
         if d == h {
             return 0.0;
         }
-        self.state.apply(c);
+        self.state.apply_lazy(c);
         self.path.push(c);
         let v = self.selective_node(d, h);
         self.path.pop();
@@ -175,7 +204,7 @@ impl Searcher<'_> {
         self.nodes += 1;
         let mut best = f64::NEG_INFINITY;
         for c in table.by_triangle[t as usize] {
-            if c == NONE || !self.state.is_allowed(c) {
+            if c == NONE || !self.state.is_allowed_lazy(c) {
                 continue;
             }
             let v = table.eta[c as usize] + self.selective_child(c, d + 1, h);
@@ -196,7 +225,7 @@ impl Searcher<'_> {
                 if n == NONE {
                     continue;
                 }
-                let k = self.state.allowed_count(n);
+                let k = self.state.allowed_count_lazy(n);
                 if k == 0 || k > kmin {
                     continue;
                 }
@@ -213,6 +242,7 @@ impl Searcher<'_> {
             let i = self.pick(self.near.len());
             return Some(self.near[i]);
         }
+        self.state.resolve_all();
         let k = self.state.min_k()?;
         let n = self.state.bucket(k).len();
         let i = self.pick(n);
