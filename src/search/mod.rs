@@ -142,6 +142,10 @@ pub struct Searcher<'a> {
     state: State<'a>,
     /// Candidates by decreasing eta, ties by increasing index.
     order: Vec<u32>,
+    /// Position of each candidate in `order`.
+    rank: Vec<u32>,
+    /// Greedy: ranks before the cursor to look at again (their verdict may have changed).
+    revisit: std::collections::BinaryHeap<std::cmp::Reverse<u32>>,
     /// First entry of `order` that may still be live on the main trajectory.
     cursor: usize,
     rng: ChaCha8Rng,
@@ -160,9 +164,15 @@ impl<'a> Searcher<'a> {
                 .total_cmp(&table.eta[a as usize])
                 .then(a.cmp(&b))
         });
+        let mut rank = vec![0u32; order.len()];
+        for (i, &c) in order.iter().enumerate() {
+            rank[c as usize] = i as u32;
+        }
         Searcher {
             state: State::new(mesh, table),
             order,
+            rank,
+            revisit: std::collections::BinaryHeap::new(),
             cursor: 0,
             rng: ChaCha8Rng::seed_from_u64(0),
             nodes: 0,

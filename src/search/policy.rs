@@ -39,23 +39,47 @@ impl Searcher<'_> {
         chosen
     }
 
-    /// Decreasing eta among allowed actions.
+    /// Decreasing eta among allowed actions. The cursor passes used and forbidden actions
+    /// for good; an action behind it is looked at again only when an action marked its
+    /// verdict stale, so each step costs what changed, not a rescan.
     pub(super) fn greedy(&mut self) {
+        self.revisit.clear();
+        let mut seen = self.state.dirty_since(0).len();
         loop {
-            self.advance_cursor();
-            // Verdicts are rechecked lazily: only those greedy looks at.
             let mut next = NONE;
-            for i in self.cursor..self.order.len() {
-                let c = self.order[i];
+            while let Some(&std::cmp::Reverse(r)) = self.revisit.peek() {
+                self.revisit.pop();
+                let c = self.order[r as usize];
                 if self.state.is_allowed_lazy(c) {
                     next = c;
                     break;
                 }
             }
             if next == NONE {
+                while self.cursor < self.order.len() {
+                    let c = self.order[self.cursor];
+                    self.cursor += 1;
+                    if self.state.is_allowed_lazy(c) {
+                        next = c;
+                        break;
+                    }
+                }
+            } else {
+                // A revisited action wins only if it comes before everything ahead.
+                debug_assert!((self.rank[next as usize] as usize) < self.cursor);
+            }
+            if next == NONE {
                 break;
             }
             self.state.apply_lazy(next);
+            let fresh = self.state.dirty_since(seen);
+            seen += fresh.len();
+            for &c in fresh {
+                let r = self.rank[c as usize];
+                if (r as usize) < self.cursor {
+                    self.revisit.push(std::cmp::Reverse(r));
+                }
+            }
         }
     }
 

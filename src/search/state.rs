@@ -802,6 +802,12 @@ impl<'a> State<'a> {
         }
     }
 
+    /// Candidates marked stale since the list was last emptied (from position `from`):
+    /// lets greedy revisit exactly the actions whose verdict may have changed.
+    pub(crate) fn dirty_since(&self, from: usize) -> &[u32] {
+        &self.dirty_list[from.min(self.dirty_list.len())..]
+    }
+
     /// Exact allowed-ness inside a lazy tree (rechecks `c` first if needed).
     #[inline]
     pub(crate) fn is_allowed_lazy(&mut self, c: u32) -> bool {
@@ -841,7 +847,18 @@ impl<'a> State<'a> {
             self.is_live(c),
             "apply({c}): a triangle of the pair is already used"
         );
-        let r = self.check(c);
+        // An exact verdict that found one part needs no new search; a split does (its
+        // parts are relabelled).
+        let known = !self.dirty[ci] && self.allowed[ci] && self.kind[ci] != KIND_SPLIT;
+        let r = if known {
+            self.nsearch = 0;
+            Check {
+                allowed: true,
+                kind: self.kind[ci],
+            }
+        } else {
+            self.check(c)
+        };
         self.log.push(Op::Apply(c));
         // Polder bookkeeping.
         let p = self.polder[t0 as usize];
@@ -1165,4 +1182,93 @@ pub fn naive_allowed(mesh: &Mesh, table: &CandidateTable, alive: &[bool]) -> Vec
             odd <= 1
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::MeshData;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// A jittered `n` x `n` grid of split squares with one square removed (a hole) and one
+    /// extra lone triangle (an odd component).
+    fn mesh(n: usize, seed: u64) -> Mesh {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut d = MeshData::default();
+        for j in 0..=n {
+            for i in 0..=n {
+                let inner = i > 0 && j > 0 && i < n && j < n;
+                let mut jit = || (rng.next_u64() as f64 / u64::MAX as f64 - 0.5) * 0.4;
+                let (dx, dy) = if inner { (jit(), jit()) } else { (0.0, 0.0) };
+                d.vertices.push([i as f64 + dx, j as f64 + dy, 0.0]);
+            }
+        }
+        let v = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        for j in 0..n {
+            for i in 0..n {
+                if (i, j) == (n / 2, n / 2) {
+                    continue;
+                }
+                if (i + j) % 3 == 0 {
+                    d.triangles.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+                    d.triangles.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+                } else {
+                    d.triangles.push([v(i, j), v(i + 1, j), v(i, j + 1)]);
+                    d.triangles
+                        .push([v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)]);
+                }
+            }
+        }
+        let b = d.vertices.len() as u32;
+        d.vertices
+            .extend([[-3.0, 0.0, 0.0], [-2.0, 0.0, 0.0], [-3.0, 1.0, 0.0]]);
+        d.triangles.push([b, b + 1, b + 2]);
+        Mesh::new(d).unwrap()
+    }
+
+    /// Lazy applies (as the trees do) with lazy queries must agree with the naive criterion
+    /// once resolved, and undo must restore the exact earlier state.
+    #[test]
+    fn lazy_walks_resolve_to_the_naive_criterion() {
+        for seed in 0..4 {
+            let m = mesh(7, seed);
+            let table = CandidateTable::build(&m);
+            let mut st = State::new(&m, &table);
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            for _ in 0..3 {
+                loop {
+                    // Lazy queries agree with the naive criterion on what they read.
+                    let naive = naive_allowed(&m, &table, &st.alive);
+                    let c = (rng.next_u64() % table.len() as u64) as u32;
+                    assert_eq!(st.is_allowed_lazy(c), naive[c as usize], "candidate {c}");
+                    let t = table.pairs[c as usize][0];
+                    let k = table.by_triangle[t as usize]
+                        .iter()
+                        .filter(|&&x| x != NONE && naive[x as usize])
+                        .count() as u32;
+                    let k = if st.is_remaining(t) { k } else { 0 };
+                    assert_eq!(st.allowed_count_lazy(t), k);
+                    let allowed: Vec<u32> = (0..table.len() as u32)
+                        .filter(|&x| naive[x as usize])
+                        .collect();
+                    if allowed.is_empty() {
+                        break;
+                    }
+                    if st.depth() > 0 && rng.next_u64() % 4 == 0 {
+                        st.undo();
+                    } else {
+                        let a = allowed[(rng.next_u64() % allowed.len() as u64) as usize];
+                        st.apply_lazy(a);
+                    }
+                    if rng.next_u64() % 3 == 0 {
+                        st.resolve_all();
+                        st.sanity_check().unwrap();
+                    }
+                }
+                st.reset();
+                st.sanity_check().unwrap();
+            }
+        }
+    }
 }

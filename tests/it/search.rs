@@ -365,3 +365,97 @@ fn algo_names_parse() {
     assert!("blossom".parse::<Algo>().is_err());
     assert!("uniform:0".parse::<Algo>().is_err());
 }
+
+#[test]
+fn recombine_cli_prints_json_and_writes_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = crate::util::run_in(
+        dir.path(),
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "selective",
+            "--horizon",
+            "2",
+            "--seed",
+            "7",
+            "--json",
+            "-o",
+            "out.msh",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in [
+        "mesh",
+        "triangles",
+        "algo",
+        "horizon",
+        "seed",
+        "quads",
+        "triangles_left",
+        "recombined_pct",
+        "quality",
+        "time_s",
+        "nodes_expanded",
+        "decisions",
+        "quality_pct",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key} in {v}");
+    }
+    assert_eq!(v["algo"], "selective");
+    assert_eq!(v["horizon"], 2);
+    assert_eq!(v["seed"], 7);
+    let (quads, left, nt) = (
+        v["quads"].as_u64().unwrap(),
+        v["triangles_left"].as_u64().unwrap(),
+        v["triangles"].as_u64().unwrap(),
+    );
+    assert_eq!(2 * quads + left, nt);
+    let pct = v["quality_pct"].as_f64().unwrap();
+    assert!(pct > 90.0 && pct <= 100.0 + 1e-9, "{pct}");
+    // Same seed, same run, through the library.
+    let mesh = quadrecomb::mesh::load("sphere").unwrap();
+    let table = CandidateTable::build(&mesh);
+    let lib = search::run(&mesh, &table, Algo::Selective { horizon: 2 }, 7);
+    assert_eq!(lib.quads as u64, quads);
+    assert!((lib.quality - v["quality"].as_f64().unwrap()).abs() < 1e-9);
+    // The written mesh holds the quads and the leftover triangles.
+    let back = quadrecomb::mesh::msh::read(&dir.path().join("out.msh")).unwrap();
+    assert_eq!(back.quads.len() as u64, quads);
+    assert_eq!(back.num_triangles() as u64, left);
+    let vtu = crate::util::run_in(
+        dir.path(),
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "greedy",
+            "-o",
+            "out.vtu",
+            "--no-optimum",
+        ],
+    );
+    assert!(vtu.status.success());
+    assert!(dir.path().join("out.vtu").exists());
+    // Bad input: zero horizon, unknown output format.
+    for args in [
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "selective",
+            "--horizon",
+            "0",
+        ][..],
+        &["recombine", "sphere", "--algo", "greedy", "-o", "out.obj"][..],
+    ] {
+        let bad = crate::util::run_in(dir.path(), args);
+        assert_eq!(bad.status.code(), Some(2), "{args:?}");
+    }
+}
