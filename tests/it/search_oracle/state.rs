@@ -232,3 +232,144 @@ proptest! {
         }
     }
 }
+
+/// A walk on a mesh too large for full checks: after every apply and undo, `is_remaining` for
+/// every triangle, `is_allowed` for `sample` random candidates and for every candidate of the
+/// triangles next to the last action, and `allowed_count` for the triangles of those
+/// candidates, all against the oracle.
+fn sampled_walk(name: &str, mesh: &Mesh, seed: u64, sample: usize, max_depth: usize) {
+    use rand::{RngExt, SeedableRng};
+    let table = CandidateTable::build(mesh);
+    let mut state = State::new(mesh, &table);
+    let mut oracle = super::naive::Naive::new(mesh, &table);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let nc = table.len() as u32;
+    let check = |state: &State<'_>,
+                 oracle: &super::naive::Naive,
+                 rng: &mut rand_chacha::ChaCha8Rng,
+                 last: u32,
+                 what: &str| {
+        let context = || {
+            format!(
+                "mesh {name}, seed {seed:#x}, {what}, path {:?}",
+                oracle.path()
+            )
+        };
+        for t in 0..mesh.num_triangles() as u32 {
+            assert_eq!(
+                state.is_remaining(t),
+                oracle.is_remaining(t),
+                "is_remaining({t}): {}",
+                context()
+            );
+        }
+        let mut cands: Vec<u32> = (0..sample).map(|_| rng.random_range(0..nc)).collect();
+        for t in table.pairs[last as usize] {
+            for &u in &mesh.topology.neighbours[t as usize] {
+                if u != quadrecomb::mesh::NONE {
+                    cands.extend(
+                        table.by_triangle[u as usize]
+                            .iter()
+                            .filter(|&&c| c != quadrecomb::mesh::NONE),
+                    );
+                }
+            }
+        }
+        for c in cands {
+            assert_eq!(
+                state.is_allowed(c),
+                oracle.is_allowed(c),
+                "is_allowed({c}) {:?}: {}",
+                oracle.parts(c),
+                context()
+            );
+            for t in table.pairs[c as usize] {
+                let expected = if oracle.is_remaining(t) {
+                    table.by_triangle[t as usize]
+                        .iter()
+                        .filter(|&&d| d != quadrecomb::mesh::NONE && oracle.is_allowed(d))
+                        .count() as u32
+                } else {
+                    0
+                };
+                assert_eq!(
+                    state.allowed_count(t),
+                    expected,
+                    "allowed_count({t}): {}",
+                    context()
+                );
+            }
+        }
+    };
+    let mut step = 0;
+    loop {
+        let allowed = state.allowed_actions();
+        if allowed.is_empty() {
+            break;
+        }
+        let depth = rng.random_range(0..=max_depth);
+        for d in 0..depth {
+            let here = state.allowed_actions();
+            if here.is_empty() {
+                break;
+            }
+            let c = here[rng.random_range(0..here.len())];
+            state.apply(c);
+            oracle.apply(c);
+            check(
+                &state,
+                &oracle,
+                &mut rng,
+                c,
+                &format!("decision {step}, exploration depth {d}: after apply({c})"),
+            );
+        }
+        while oracle.path().len() > step {
+            let c = *oracle.path().last().unwrap();
+            state.undo();
+            oracle.undo();
+            check(
+                &state,
+                &oracle,
+                &mut rng,
+                c,
+                &format!("decision {step}: after undo() of {c}"),
+            );
+        }
+        let c = allowed[rng.random_range(0..allowed.len())];
+        state.apply(c);
+        oracle.apply(c);
+        step += 1;
+        check(
+            &state,
+            &oracle,
+            &mut rng,
+            c,
+            &format!("decision {step}: after apply({c})"),
+        );
+    }
+    for t in 0..mesh.num_triangles() as u32 {
+        for &c in &table.by_triangle[t as usize] {
+            if c != quadrecomb::mesh::NONE {
+                assert!(
+                    !oracle.is_allowed(c),
+                    "{name}: the state allows nothing, the oracle allows {c}"
+                );
+            }
+        }
+    }
+}
+
+/// Long soak, not run by default (`cargo test --release --test it soak -- --ignored`): many
+/// more seeds on the sample meshes and sampled checks on the built-in sphere.
+#[test]
+#[ignore]
+fn soak_state_matches_oracle() {
+    for (name, mesh) in sample_meshes(SEED ^ 0xABCD) {
+        check_mesh(&name, &mesh, 0..6, WalkConfig::default());
+    }
+    let sphere = quadrecomb::mesh::load("sphere").expect("built-in sphere");
+    for s in 0..2 {
+        sampled_walk("sphere", &sphere, SEED ^ s, 40, 8);
+    }
+}
