@@ -990,43 +990,55 @@ impl Solver {
     /// every enclosing cycle (no recursion: a work stack).
     fn rotate(&mut self, b: u32, v: u32) {
         let mut stack = vec![(b, v)];
+        let mut chain = Vec::new();
         while let Some((b, v)) = stack.pop() {
+            // The blossoms from `b` down to `v`, each rotated once.
+            chain.clear();
             let mut t = v;
-            while self.parent[t as usize] != b {
+            while t != b {
+                chain.push(t);
                 t = self.parent[t as usize];
             }
-            if self.is_blossom(t) {
-                stack.push((t, v));
+            let mut x = b;
+            for &t in chain.iter().rev() {
+                self.rotate_level(x, t, &mut stack);
+                self.base[x as usize] = v;
+                x = t;
             }
-            let bi = b as usize - self.n;
-            let k = self.children[bi].len();
-            let i = self.children[bi]
-                .iter()
-                .position(|&c| c == t)
-                .expect("child");
-            if i != 0 {
-                let js: Vec<usize> = if i % 2 == 0 {
-                    (0..i - 1).step_by(2).collect()
-                } else {
-                    (i + 1..k).step_by(2).collect()
-                };
-                for j in js {
-                    let [a, c] = self.cedges[bi][j];
-                    let (ca, cc) = (self.children[bi][j], self.children[bi][(j + 1) % k]);
-                    self.mate[a as usize] = c;
-                    self.mate[c as usize] = a;
-                    if self.is_blossom(ca) {
-                        stack.push((ca, a));
-                    }
-                    if self.is_blossom(cc) {
-                        stack.push((cc, c));
-                    }
-                }
-                self.children[bi].rotate_left(i);
-                self.cedges[bi].rotate_left(i);
-            }
-            self.base[b as usize] = v;
         }
+    }
+
+    /// Rotates the cycle of blossom `b` so that its child `t` comes first, rematching the
+    /// even path; sub-blossoms whose base changes go on `stack`.
+    fn rotate_level(&mut self, b: u32, t: u32, stack: &mut Vec<(u32, u32)>) {
+        let bi = b as usize - self.n;
+        let k = self.children[bi].len();
+        let i = self.children[bi]
+            .iter()
+            .position(|&c| c == t)
+            .expect("child");
+        if i == 0 {
+            return;
+        }
+        let js = if i % 2 == 0 {
+            (0..i - 1).step_by(2)
+        } else {
+            (i + 1..k).step_by(2)
+        };
+        for j in js {
+            let [a, c] = self.cedges[bi][j];
+            let (ca, cc) = (self.children[bi][j], self.children[bi][(j + 1) % k]);
+            self.mate[a as usize] = c;
+            self.mate[c as usize] = a;
+            if self.is_blossom(ca) {
+                stack.push((ca, a));
+            }
+            if self.is_blossom(cc) {
+                stack.push((cc, c));
+            }
+        }
+        self.children[bi].rotate_left(i);
+        self.cedges[bi].rotate_left(i);
     }
 
     fn check(&self, g: &Graph) -> Result<CheckReport, String> {
@@ -1192,35 +1204,5 @@ impl Solver {
             }
         }
         (a != NONE).then_some(a)
-    }
-}
-
-impl Matching {
-    /// Temporary: (max nesting depth, max blossom size, sum of top-level blossom sizes).
-    pub fn shape(&self) -> (usize, usize, usize) {
-        let s = &self.s;
-        let mut maxd = 0;
-        for v in 0..s.n {
-            let mut d = 0;
-            let mut x = s.parent[v];
-            while x != NONE {
-                d += 1;
-                x = s.parent[x as usize];
-            }
-            maxd = maxd.max(d);
-        }
-        let mut maxs = 0;
-        let mut tot = 0;
-        for b in s.n..s.parent.len() {
-            if s.is_blossom(b as u32) {
-                let mut l = Vec::new();
-                s.leaves_into(b as u32, &mut l);
-                maxs = maxs.max(l.len());
-                if s.parent[b] == NONE {
-                    tot += l.len();
-                }
-            }
-        }
-        (maxd, maxs, tot)
     }
 }
