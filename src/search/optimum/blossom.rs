@@ -484,6 +484,34 @@ impl Solver {
                 }
             }
         }
+        // Augmenting paths of length three along tight edges: free v, w = x, free z.
+        for v in 0..self.n as u32 {
+            if self.mate[v as usize] != NONE {
+                continue;
+            }
+            let yv = self.dual[v as usize];
+            'found: for k in g.adj(v) {
+                let w = g.nbr[k];
+                let x = self.mate[w as usize];
+                if x == NONE || self.cost_k(g, k) != yv + self.dual[w as usize] {
+                    continue;
+                }
+                let yx = self.dual[x as usize];
+                for k2 in g.adj(x) {
+                    let z = g.nbr[k2];
+                    if z != v
+                        && self.mate[z as usize] == NONE
+                        && self.cost_k(g, k2) == yx + self.dual[z as usize]
+                    {
+                        self.mate[v as usize] = w;
+                        self.mate[w as usize] = v;
+                        self.mate[x as usize] = z;
+                        self.mate[z as usize] = x;
+                        break 'found;
+                    }
+                }
+            }
+        }
     }
 
     /// Adds a dummy vertex to component `c`, joined to all its vertices at cost 0, with the
