@@ -539,8 +539,10 @@ impl Solver {
             for k in g.adj(v) {
                 f(self, g.nbr[k], self.cost_k(g, k));
             }
-            for &d in &self.comp_dummies[self.comp[v as usize] as usize] {
-                f(self, d, 0);
+            if self.stats.dummies > 0 {
+                for &d in &self.comp_dummies[self.comp[v as usize] as usize] {
+                    f(self, d, 0);
+                }
             }
         } else {
             let c = self.comp[v as usize] as usize;
