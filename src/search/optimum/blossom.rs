@@ -91,6 +91,9 @@ impl Graph {
     }
 }
 
+/// Events a short single-tree search may use before it is handed to the forest.
+const SHORT_SEARCH_EVENTS: usize = 64;
+
 /// Counters of one solve, for benchmarks and tests.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Stats {
@@ -406,7 +409,17 @@ impl Solver {
         self.stats.free_after_greedy = (0..self.n)
             .filter(|&v| self.mate[v] == NONE && self.comp_size(self.comp[v]) > 1)
             .count();
-        self.grow_forest(g);
+        // Short single-tree searches first: most free vertices find a partner nearby, and a
+        // search that runs long is stopped (its dual progress is kept) for the forest.
+        for r in 0..self.n as u32 {
+            if self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1 {
+                self.grow_forest(g, &[r], SHORT_SEARCH_EVENTS);
+            }
+        }
+        let roots: Vec<u32> = (0..self.n as u32)
+            .filter(|&r| self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1)
+            .collect();
+        self.grow_forest(g, &roots, usize::MAX);
         self.heap = BinaryHeap::new();
         // Every node is free again: fold the handles' offsets into the leaves.
         for v in 0..self.parent.len() {
@@ -632,13 +645,15 @@ impl Solver {
     /// Grows alternating trees from every free vertex at once, with one dual step `delta`
     /// for all: plus nodes rise, minus nodes fall. Two trees that meet augment and dissolve;
     /// the others go on.
-    fn grow_forest(&mut self, g: &Graph) {
+    ///
+    /// With a finite `budget` (events), a single tree that has not augmented by then stops at
+    /// an even dual step (so that every free vertex keeps an even dual, which keeps slacks
+    /// between plus nodes of different trees even) and is dissolved.
+    fn grow_forest(&mut self, g: &Graph, roots: &[u32], budget: usize) {
         self.delta = 0;
         self.heap.clear();
-        let roots: Vec<u32> = (0..self.n as u32)
-            .filter(|&r| self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1)
-            .collect();
-        for &r in &roots {
+        let mut events = 0usize;
+        for &r in roots {
             let t = self.trees.len() as u32;
             self.trees.push(Vec::new());
             self.tree_alive.push(true);
@@ -649,7 +664,28 @@ impl Solver {
             self.make_plus(g, root, t);
         }
         while self.alive > 0 {
+            if events >= budget {
+                let next = self.heap.peek().map(|e| e.0.0);
+                if next.is_none_or(|k| k > self.delta) {
+                    if self.delta % 2 != 0 {
+                        self.delta += 1;
+                    }
+                    debug_assert!(next.is_none_or(|k| k >= self.delta));
+                    let alive: Vec<u32> = (0..self.trees.len() as u32)
+                        .filter(|&t| self.tree_alive[t as usize])
+                        .collect();
+                    for t in alive {
+                        self.dissolve(g, t);
+                    }
+                    break;
+                }
+            }
+            events += 1;
             let Some(Reverse((key, a, b))) = self.heap.pop() else {
+                if budget != usize::MAX {
+                    events = budget;
+                    continue;
+                }
                 self.add_dummies(g);
                 continue;
             };
