@@ -91,6 +91,9 @@ impl Graph {
     }
 }
 
+/// Events a short single-tree search may use before it is handed to the forest.
+const SHORT_SEARCH_EVENTS: usize = 64;
+
 /// Counters of one solve, for benchmarks and tests.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Stats {
@@ -406,7 +409,17 @@ impl Solver {
         self.stats.free_after_greedy = (0..self.n)
             .filter(|&v| self.mate[v] == NONE && self.comp_size(self.comp[v]) > 1)
             .count();
-        self.grow_forest(g);
+        // Short single-tree searches first: most free vertices find a partner nearby, and a
+        // search that runs long is stopped (its dual progress is kept) for the forest.
+        for r in 0..self.n as u32 {
+            if self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1 {
+                self.grow_forest(g, &[r], SHORT_SEARCH_EVENTS);
+            }
+        }
+        let roots: Vec<u32> = (0..self.n as u32)
+            .filter(|&r| self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1)
+            .collect();
+        self.grow_forest(g, &roots, usize::MAX);
         self.heap = BinaryHeap::new();
         // Every node is free again: fold the handles' offsets into the leaves.
         for v in 0..self.parent.len() {
@@ -484,6 +497,34 @@ impl Solver {
                 }
             }
         }
+        // Augmenting paths of length three along tight edges: free v, w = x, free z.
+        for v in 0..self.n as u32 {
+            if self.mate[v as usize] != NONE {
+                continue;
+            }
+            let yv = self.dual[v as usize];
+            'found: for k in g.adj(v) {
+                let w = g.nbr[k];
+                let x = self.mate[w as usize];
+                if x == NONE || self.cost_k(g, k) != yv + self.dual[w as usize] {
+                    continue;
+                }
+                let yx = self.dual[x as usize];
+                for k2 in g.adj(x) {
+                    let z = g.nbr[k2];
+                    if z != v
+                        && self.mate[z as usize] == NONE
+                        && self.cost_k(g, k2) == yx + self.dual[z as usize]
+                    {
+                        self.mate[v as usize] = w;
+                        self.mate[w as usize] = v;
+                        self.mate[x as usize] = z;
+                        self.mate[z as usize] = x;
+                        break 'found;
+                    }
+                }
+            }
+        }
     }
 
     /// Adds a dummy vertex to component `c`, joined to all its vertices at cost 0, with the
@@ -511,8 +552,10 @@ impl Solver {
             for k in g.adj(v) {
                 f(self, g.nbr[k], self.cost_k(g, k));
             }
-            for &d in &self.comp_dummies[self.comp[v as usize] as usize] {
-                f(self, d, 0);
+            if self.stats.dummies > 0 {
+                for &d in &self.comp_dummies[self.comp[v as usize] as usize] {
+                    f(self, d, 0);
+                }
             }
         } else {
             let c = self.comp[v as usize] as usize;
@@ -602,13 +645,15 @@ impl Solver {
     /// Grows alternating trees from every free vertex at once, with one dual step `delta`
     /// for all: plus nodes rise, minus nodes fall. Two trees that meet augment and dissolve;
     /// the others go on.
-    fn grow_forest(&mut self, g: &Graph) {
+    ///
+    /// With a finite `budget` (events), a single tree that has not augmented by then stops at
+    /// an even dual step (so that every free vertex keeps an even dual, which keeps slacks
+    /// between plus nodes of different trees even) and is dissolved.
+    fn grow_forest(&mut self, g: &Graph, roots: &[u32], budget: usize) {
         self.delta = 0;
         self.heap.clear();
-        let roots: Vec<u32> = (0..self.n as u32)
-            .filter(|&r| self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1)
-            .collect();
-        for &r in &roots {
+        let mut events = 0usize;
+        for &r in roots {
             let t = self.trees.len() as u32;
             self.trees.push(Vec::new());
             self.tree_alive.push(true);
@@ -619,7 +664,28 @@ impl Solver {
             self.make_plus(g, root, t);
         }
         while self.alive > 0 {
+            if events >= budget {
+                let next = self.heap.peek().map(|e| e.0.0);
+                if next.is_none_or(|k| k > self.delta) {
+                    if self.delta % 2 != 0 {
+                        self.delta += 1;
+                    }
+                    debug_assert!(next.is_none_or(|k| k >= self.delta));
+                    let alive: Vec<u32> = (0..self.trees.len() as u32)
+                        .filter(|&t| self.tree_alive[t as usize])
+                        .collect();
+                    for t in alive {
+                        self.dissolve(g, t);
+                    }
+                    break;
+                }
+            }
+            events += 1;
             let Some(Reverse((key, a, b))) = self.heap.pop() else {
+                if budget != usize::MAX {
+                    events = budget;
+                    continue;
+                }
                 self.add_dummies(g);
                 continue;
             };
@@ -990,43 +1056,55 @@ impl Solver {
     /// every enclosing cycle (no recursion: a work stack).
     fn rotate(&mut self, b: u32, v: u32) {
         let mut stack = vec![(b, v)];
+        let mut chain = Vec::new();
         while let Some((b, v)) = stack.pop() {
+            // The blossoms from `b` down to `v`, each rotated once.
+            chain.clear();
             let mut t = v;
-            while self.parent[t as usize] != b {
+            while t != b {
+                chain.push(t);
                 t = self.parent[t as usize];
             }
-            if self.is_blossom(t) {
-                stack.push((t, v));
+            let mut x = b;
+            for &t in chain.iter().rev() {
+                self.rotate_level(x, t, &mut stack);
+                self.base[x as usize] = v;
+                x = t;
             }
-            let bi = b as usize - self.n;
-            let k = self.children[bi].len();
-            let i = self.children[bi]
-                .iter()
-                .position(|&c| c == t)
-                .expect("child");
-            if i != 0 {
-                let js: Vec<usize> = if i % 2 == 0 {
-                    (0..i - 1).step_by(2).collect()
-                } else {
-                    (i + 1..k).step_by(2).collect()
-                };
-                for j in js {
-                    let [a, c] = self.cedges[bi][j];
-                    let (ca, cc) = (self.children[bi][j], self.children[bi][(j + 1) % k]);
-                    self.mate[a as usize] = c;
-                    self.mate[c as usize] = a;
-                    if self.is_blossom(ca) {
-                        stack.push((ca, a));
-                    }
-                    if self.is_blossom(cc) {
-                        stack.push((cc, c));
-                    }
-                }
-                self.children[bi].rotate_left(i);
-                self.cedges[bi].rotate_left(i);
-            }
-            self.base[b as usize] = v;
         }
+    }
+
+    /// Rotates the cycle of blossom `b` so that its child `t` comes first, rematching the
+    /// even path; sub-blossoms whose base changes go on `stack`.
+    fn rotate_level(&mut self, b: u32, t: u32, stack: &mut Vec<(u32, u32)>) {
+        let bi = b as usize - self.n;
+        let k = self.children[bi].len();
+        let i = self.children[bi]
+            .iter()
+            .position(|&c| c == t)
+            .expect("child");
+        if i == 0 {
+            return;
+        }
+        let js = if i % 2 == 0 {
+            (0..i - 1).step_by(2)
+        } else {
+            (i + 1..k).step_by(2)
+        };
+        for j in js {
+            let [a, c] = self.cedges[bi][j];
+            let (ca, cc) = (self.children[bi][j], self.children[bi][(j + 1) % k]);
+            self.mate[a as usize] = c;
+            self.mate[c as usize] = a;
+            if self.is_blossom(ca) {
+                stack.push((ca, a));
+            }
+            if self.is_blossom(cc) {
+                stack.push((cc, c));
+            }
+        }
+        self.children[bi].rotate_left(i);
+        self.cedges[bi].rotate_left(i);
     }
 
     fn check(&self, g: &Graph) -> Result<CheckReport, String> {
@@ -1192,35 +1270,5 @@ impl Solver {
             }
         }
         (a != NONE).then_some(a)
-    }
-}
-
-impl Matching {
-    /// Temporary: (max nesting depth, max blossom size, sum of top-level blossom sizes).
-    pub fn shape(&self) -> (usize, usize, usize) {
-        let s = &self.s;
-        let mut maxd = 0;
-        for v in 0..s.n {
-            let mut d = 0;
-            let mut x = s.parent[v];
-            while x != NONE {
-                d += 1;
-                x = s.parent[x as usize];
-            }
-            maxd = maxd.max(d);
-        }
-        let mut maxs = 0;
-        let mut tot = 0;
-        for b in s.n..s.parent.len() {
-            if s.is_blossom(b as u32) {
-                let mut l = Vec::new();
-                s.leaves_into(b as u32, &mut l);
-                maxs = maxs.max(l.len());
-                if s.parent[b] == NONE {
-                    tot += l.len();
-                }
-            }
-        }
-        (maxd, maxs, tot)
     }
 }
