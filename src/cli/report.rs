@@ -1,10 +1,89 @@
-//! `quadrecomb report`.
+//! `quadrecomb report DIR [--compare DIR2] [--zoom x0,y0,x1,y1]`.
 
+use super::BadInput;
+use quadrecomb::report::{self, ReportOptions};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Results directory of a sweep (holding runs.jsonl and manifest.json).
+    dir: PathBuf,
+    /// Another results directory to compare with, configuration by configuration.
+    #[arg(long, value_name = "DIR2")]
+    compare: Option<PathBuf>,
+    /// Also draw the mesh pictures zoomed into this window (picture coordinates).
+    #[arg(long, value_name = "x0,y0,x1,y1")]
+    zoom: Option<String>,
+    /// Picture the typical run of this configuration, e.g. `selective:5` or `greedy`
+    /// (repeatable; default: greedy and the best horizon of each look-ahead algorithm).
+    #[arg(long = "picture", value_name = "ALGO[:H]")]
+    pictures: Vec<String>,
+    /// Leave out the mesh pictures (they re-run each typical run).
+    #[arg(long)]
+    no_pictures: bool,
+    /// Seed of the bootstrap confidence intervals.
+    #[arg(long, default_value_t = ReportOptions::default().seed)]
+    seed: u64,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`quadrecomb report` is not implemented yet")
+/// Parses "x0,y0,x1,y1" into a window with x0 < x1 and y0 < y1.
+fn parse_zoom(s: &str) -> Result<[f64; 4], BadInput> {
+    let bad = || {
+        BadInput(format!(
+            "bad --zoom {s:?}: expected x0,y0,x1,y1 with x0 < x1 and y0 < y1, e.g. 0.6,0.6,1,1"
+        ))
+    };
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    match v[..] {
+        [x0, y0, x1, y1] if v.iter().all(|c| c.is_finite()) && x0 < x1 && y0 < y1 => {
+            Ok([x0, y0, x1, y1])
+        }
+        _ => Err(bad()),
+    }
+}
+
+/// Parses "algo" or "algo:h".
+fn parse_picture(s: &str) -> Result<(String, Option<u32>), BadInput> {
+    match s.split_once(':') {
+        None => Ok((s.to_string(), None)),
+        Some((a, h)) => h
+            .parse::<u32>()
+            .map(|h| (a.to_string(), Some(h)))
+            .map_err(|_| {
+                BadInput(format!(
+                    "bad --picture {s:?}: expected ALGO or ALGO:H, e.g. selective:5"
+                ))
+            }),
+    }
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let zoom = args.zoom.as_deref().map(parse_zoom).transpose()?;
+    let picture_configs = args
+        .pictures
+        .iter()
+        .map(|s| parse_picture(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    let opts = ReportOptions {
+        compare: args.compare,
+        zoom,
+        pictures: !args.no_pictures,
+        picture_configs,
+        seed: args.seed,
+    };
+    let paths = report::write(&args.dir, &opts).map_err(|e| match e {
+        report::ReportError::Plot(_) => anyhow::Error::new(e),
+        other => anyhow::Error::new(BadInput(other.to_string())),
+    })?;
+    println!("{}", paths.markdown.display());
+    println!("{}", paths.html.display());
+    for f in &paths.figures {
+        println!("{}", f.display());
+    }
+    Ok(ExitCode::SUCCESS)
 }

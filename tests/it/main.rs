@@ -3,6 +3,7 @@
 mod io;
 mod meshes;
 mod optimum;
+mod report;
 mod runner;
 mod search;
 mod util;

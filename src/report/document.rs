@@ -1,0 +1,210 @@
+//! A report as a list of blocks, rendered both to Markdown (figures linked as SVG files) and to
+//! a self-contained HTML page (figures inlined).
+
+/// One block of a report.
+#[derive(Debug, Clone)]
+pub enum Block {
+    /// A heading of level 1..=4.
+    Heading(u8, String),
+    /// A paragraph of plain text.
+    Para(String),
+    /// A bulleted list of plain-text items.
+    List(Vec<String>),
+    /// A table: header cells and rows of cells (plain text).
+    Table {
+        /// Column titles.
+        header: Vec<String>,
+        /// Rows, each as many cells as the header.
+        rows: Vec<Vec<String>>,
+    },
+    /// A figure: its SVG, the file name it is written to (relative to the report), a caption.
+    Figure {
+        /// File name of the SVG, relative to the report's directory.
+        file: String,
+        /// The SVG document.
+        svg: String,
+        /// Caption (plain text).
+        caption: String,
+    },
+}
+
+/// A report being built.
+#[derive(Debug, Clone, Default)]
+pub struct Document {
+    /// The blocks, in order.
+    pub blocks: Vec<Block>,
+}
+
+impl Document {
+    /// Appends a heading.
+    pub fn heading(&mut self, level: u8, text: impl Into<String>) {
+        self.blocks.push(Block::Heading(level, text.into()));
+    }
+
+    /// Appends a paragraph.
+    pub fn para(&mut self, text: impl Into<String>) {
+        self.blocks.push(Block::Para(text.into()));
+    }
+
+    /// Appends a list (nothing when empty).
+    pub fn list(&mut self, items: Vec<String>) {
+        if !items.is_empty() {
+            self.blocks.push(Block::List(items));
+        }
+    }
+
+    /// Appends a table.
+    pub fn table(&mut self, header: Vec<String>, rows: Vec<Vec<String>>) {
+        self.blocks.push(Block::Table { header, rows });
+    }
+
+    /// Appends a figure.
+    pub fn figure(&mut self, file: String, svg: String, caption: String) {
+        self.blocks.push(Block::Figure { file, svg, caption });
+    }
+
+    /// The figures, as (file, svg).
+    pub fn figures(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.blocks.iter().filter_map(|b| match b {
+            Block::Figure { file, svg, .. } => Some((file.as_str(), svg.as_str())),
+            _ => None,
+        })
+    }
+
+    /// Markdown, with figures as image links to their files.
+    pub fn to_markdown(&self) -> String {
+        let mut out = String::new();
+        for b in &self.blocks {
+            match b {
+                Block::Heading(level, text) => {
+                    out.push_str(&"#".repeat(*level as usize));
+                    out.push(' ');
+                    out.push_str(text);
+                    out.push_str("\n\n");
+                }
+                Block::Para(text) => {
+                    out.push_str(text);
+                    out.push_str("\n\n");
+                }
+                Block::List(items) => {
+                    for i in items {
+                        out.push_str("- ");
+                        out.push_str(i);
+                        out.push('\n');
+                    }
+                    out.push('\n');
+                }
+                Block::Table { header, rows } => {
+                    let cell = |s: &str| s.replace('|', "\\|");
+                    out.push_str("| ");
+                    out.push_str(
+                        &header
+                            .iter()
+                            .map(|h| cell(h))
+                            .collect::<Vec<_>>()
+                            .join(" | "),
+                    );
+                    out.push_str(" |\n|");
+                    for (i, _) in header.iter().enumerate() {
+                        out.push_str(if i == 0 { " --- |" } else { " ---: |" });
+                    }
+                    out.push('\n');
+                    for r in rows {
+                        out.push_str("| ");
+                        out.push_str(&r.iter().map(|c| cell(c)).collect::<Vec<_>>().join(" | "));
+                        out.push_str(" |\n");
+                    }
+                    out.push('\n');
+                }
+                Block::Figure { file, caption, .. } => {
+                    let alt = std::path::Path::new(file)
+                        .file_stem()
+                        .map_or(file.clone(), |s| s.to_string_lossy().into_owned());
+                    out.push_str(&format!("![{alt}]({file})\n\n"));
+                    out.push_str(&format!("*{caption}*\n\n"));
+                }
+            }
+        }
+        out
+    }
+
+    /// A self-contained HTML page with the figures' SVG inlined.
+    pub fn to_html(&self, title: &str) -> String {
+        let mut out = String::new();
+        out.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
+        out.push_str(&format!("<title>{}</title>\n", escape(title)));
+        out.push_str(
+            "<style>\nbody{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;\
+             line-height:1.45}\ntable{border-collapse:collapse;margin:1em 0;font-size:0.92em}\n\
+             th,td{border:1px solid #bbb;padding:0.25em 0.6em}td{text-align:right}\n\
+             td:first-child{text-align:left}th{background:#eee}\nfigure{margin:1.5em 0}\n\
+             figure svg{max-width:100%;height:auto}\nfigcaption{font-size:0.9em;color:#333}\n\
+             </style>\n</head>\n<body>\n",
+        );
+        for b in &self.blocks {
+            match b {
+                Block::Heading(level, text) => {
+                    out.push_str(&format!("<h{level}>{}</h{level}>\n", escape(text)));
+                }
+                Block::Para(text) => out.push_str(&format!("<p>{}</p>\n", escape(text))),
+                Block::List(items) => {
+                    out.push_str("<ul>\n");
+                    for i in items {
+                        out.push_str(&format!("<li>{}</li>\n", escape(i)));
+                    }
+                    out.push_str("</ul>\n");
+                }
+                Block::Table { header, rows } => {
+                    out.push_str("<table>\n<thead><tr>");
+                    for h in header {
+                        out.push_str(&format!("<th>{}</th>", escape(h)));
+                    }
+                    out.push_str("</tr></thead>\n<tbody>\n");
+                    for r in rows {
+                        out.push_str("<tr>");
+                        for c in r {
+                            out.push_str(&format!("<td>{}</td>", escape(c)));
+                        }
+                        out.push_str("</tr>\n");
+                    }
+                    out.push_str("</tbody>\n</table>\n");
+                }
+                Block::Figure { svg, caption, .. } => {
+                    out.push_str("<figure>\n");
+                    out.push_str(strip_xml_declaration(svg));
+                    out.push_str(&format!(
+                        "\n<figcaption>{}</figcaption>\n</figure>\n",
+                        escape(caption)
+                    ));
+                }
+            }
+        }
+        out.push_str("</body>\n</html>\n");
+        out
+    }
+}
+
+/// The SVG without an XML declaration (not allowed inside HTML).
+fn strip_xml_declaration(svg: &str) -> &str {
+    let s = svg.trim_start();
+    if s.starts_with("<?xml") {
+        s.find("?>").map_or(s, |i| s[i + 2..].trim_start())
+    } else {
+        s
+    }
+}
+
+/// HTML-escapes text.
+pub fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            _ => out.push(c),
+        }
+    }
+    out
+}

@@ -1,0 +1,206 @@
+//! Reading a results directory (`runs.jsonl`, optional `manifest.json`) and grouping its runs
+//! into configurations (mesh, algorithm, horizon).
+
+use super::ReportError;
+pub use crate::experiment::record::RunRecord as Run;
+use crate::experiment::{manifest, store};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Tree nodes expanded per decision of a run (0 when no decision was made).
+pub fn nodes_per_step(run: &Run) -> f64 {
+    if run.decisions == 0 {
+        0.0
+    } else {
+        run.nodes_expanded as f64 / run.decisions as f64
+    }
+}
+
+/// A configuration: what a group of runs shares.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Config {
+    /// Mesh name or path.
+    pub mesh: String,
+    /// Rank of the algorithm in the report's order (baselines first).
+    algo_rank: u8,
+    /// Algorithm name.
+    pub algo: String,
+    /// Horizon, if the algorithm has one.
+    pub horizon: Option<u32>,
+}
+
+impl Config {
+    /// The configuration of `run`.
+    pub fn of(run: &Run) -> Config {
+        Config {
+            mesh: run.mesh.clone(),
+            algo_rank: algo_rank(&run.algo),
+            algo: run.algo.clone(),
+            horizon: run.horizon,
+        }
+    }
+
+    /// "selective h=3", "greedy".
+    pub fn label(&self) -> String {
+        match self.horizon {
+            Some(h) => format!("{} h={h}", self.algo),
+            None => self.algo.clone(),
+        }
+    }
+}
+
+/// Order of algorithms in tables: baselines first, then uniform, selective, the optimum,
+/// unknown names.
+fn algo_rank(algo: &str) -> u8 {
+    match algo {
+        "greedy-nocrit" => 0,
+        "greedy" => 1,
+        "uniform" => 2,
+        "selective" => 3,
+        "optimum" => 4,
+        _ => 5,
+    }
+}
+
+/// The runs of one results directory, grouped by configuration.
+#[derive(Debug, Clone)]
+pub struct Results {
+    /// The directory read.
+    pub dir: PathBuf,
+    /// Runs per configuration, in report order, each group sorted by run index.
+    pub groups: BTreeMap<Config, Vec<Run>>,
+    /// Meshes in report order (order of first appearance in `runs.jsonl`).
+    pub meshes: Vec<String>,
+    /// `manifest.json`, if present.
+    pub manifest: Option<manifest::Manifest>,
+    /// Bytes of a torn last line of `runs.jsonl` (a run interrupted while being written),
+    /// ignored; 0 if none.
+    pub torn_bytes: u64,
+}
+
+impl Results {
+    /// Reads `dir/runs.jsonl` (through the runner's reader: a torn last line is ignored, any
+    /// other bad line is an error) and, if present, `dir/manifest.json`.
+    pub fn read(dir: &Path) -> Result<Results, ReportError> {
+        let path = dir.join(store::RUNS_FILE);
+        if !path.is_file() {
+            return Err(ReportError::NoRuns { path });
+        }
+        let loaded = store::read(&path)?;
+        if loaded.records.is_empty() {
+            return Err(ReportError::NoRuns { path });
+        }
+        let manifest = if dir.join(manifest::MANIFEST_FILE).is_file() {
+            Some(manifest::Manifest::read(dir)?)
+        } else {
+            None
+        };
+        Ok(Results::from_runs(
+            dir,
+            loaded.records,
+            manifest,
+            loaded.torn_bytes,
+        ))
+    }
+
+    /// Groups `runs` (already read) by configuration.
+    pub fn from_runs(
+        dir: &Path,
+        runs: Vec<Run>,
+        manifest: Option<manifest::Manifest>,
+        torn_bytes: u64,
+    ) -> Results {
+        let mut meshes: Vec<String> = Vec::new();
+        let mut groups: BTreeMap<Config, Vec<Run>> = BTreeMap::new();
+        for r in runs {
+            if !meshes.contains(&r.mesh) {
+                meshes.push(r.mesh.clone());
+            }
+            groups.entry(Config::of(&r)).or_default().push(r);
+        }
+        for g in groups.values_mut() {
+            g.sort_by_key(|r| r.run);
+        }
+        Results {
+            dir: dir.to_path_buf(),
+            groups,
+            meshes,
+            manifest,
+            torn_bytes,
+        }
+    }
+
+    /// Configurations of `mesh`, in report order.
+    pub fn configs_of<'a>(
+        &'a self,
+        mesh: &'a str,
+    ) -> impl Iterator<Item = (&'a Config, &'a [Run])> {
+        self.groups
+            .iter()
+            .filter(move |(c, _)| c.mesh == mesh)
+            .map(|(c, r)| (c, r.as_slice()))
+    }
+
+    /// The runs of a configuration, if present.
+    pub fn get(&self, mesh: &str, algo: &str, horizon: Option<u32>) -> Option<&[Run]> {
+        self.groups
+            .iter()
+            .find(|(c, _)| c.mesh == mesh && c.algo == algo && c.horizon == horizon)
+            .map(|(_, r)| r.as_slice())
+    }
+
+    /// Total number of runs.
+    pub fn num_runs(&self) -> usize {
+        self.groups.values().map(Vec::len).sum()
+    }
+}
+
+/// The measures the report summarizes and compares.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Metric {
+    /// Quality as % of the optimum (raw quality when the optimum is unknown).
+    Quality,
+    /// % of triangles recombined.
+    Recombined,
+    /// Wall time in seconds.
+    Time,
+}
+
+impl Metric {
+    /// All metrics, in report order.
+    pub const ALL: [Metric; 3] = [Metric::Quality, Metric::Recombined, Metric::Time];
+
+    /// The metric's values over `runs`. Quality is the % of optimum when every run has one,
+    /// otherwise the raw quality.
+    pub fn values(self, runs: &[Run]) -> Vec<f64> {
+        match self {
+            Metric::Quality => {
+                let pct: Option<Vec<f64>> = runs.iter().map(|r| r.quality_pct).collect();
+                pct.unwrap_or_else(|| runs.iter().map(|r| r.quality).collect())
+            }
+            Metric::Recombined => runs.iter().map(|r| r.recombined_pct).collect(),
+            Metric::Time => runs.iter().map(|r| r.time_s).collect(),
+        }
+    }
+
+    /// Name with unit, given whether quality is a percentage for these runs.
+    pub fn name(self, runs: &[Run]) -> &'static str {
+        match self {
+            Metric::Quality if runs.iter().all(|r| r.quality_pct.is_some()) => {
+                "quality (% of optimum)"
+            }
+            Metric::Quality => "quality (sum of eta)",
+            Metric::Recombined => "recombined (%)",
+            Metric::Time => "time (s)",
+        }
+    }
+
+    /// Short key for file names.
+    pub fn key(self) -> &'static str {
+        match self {
+            Metric::Quality => "quality",
+            Metric::Recombined => "recombined",
+            Metric::Time => "time",
+        }
+    }
+}

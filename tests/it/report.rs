@@ -1,0 +1,725 @@
+//! Reports: the statistics against published and scipy values, the report written from
+//! synthetic results (every configuration named, every SVG parsing and rendering with the
+//! expected boxes), mesh pictures, and the `report` subcommand.
+
+use crate::util::{SEED, run_in};
+use quadrecomb::experiment::record::RunRecord;
+use quadrecomb::mesh::{Mesh, MeshData};
+use quadrecomb::quality::{CandidateTable, recombined};
+use quadrecomb::report::picture::{PictureOptions, mesh_svg};
+use quadrecomb::report::{self, ReportOptions};
+use quadrecomb::stats::compare::{
+    Magnitude, PMethod, bootstrap_median_diff_ci, holm, mann_whitney, vargha_delaney,
+};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::path::Path;
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * b.abs().max(1e-300)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Statistics against known values.
+
+#[test]
+fn mann_whitney_exact_textbook_example() {
+    // U = 17 of x: x > y in 17 of the 20 pairs, counted by hand. Exact two-sided p = 2 P(U <= 3)
+    // for n1 = 5, n2 = 4: (1+1+2+3)/126 * 2 = 14/126 = 0.1111...; scipy 1.17.1
+    // `mannwhitneyu(x, y, method='exact')` gives (17.0, 0.1111111111111111).
+    let x = [19.0, 22.0, 16.0, 29.0, 24.0];
+    let y = [20.0, 11.0, 17.0, 12.0];
+    let r = mann_whitney(&x, &y);
+    assert_eq!(r.u, 17.0);
+    assert_eq!(r.method, PMethod::Exact);
+    assert!(close(r.p, 14.0 / 126.0, 1e-12), "{}", r.p);
+    // The other way round: U = 3, same p.
+    let r2 = mann_whitney(&y, &x);
+    assert_eq!(r2.u, 3.0);
+    assert!(close(r2.p, r.p, 1e-12));
+}
+
+#[test]
+fn mann_whitney_exact_extreme_separation() {
+    // All of x below all of y: U = 0, p = 2 / C(14, 3) = 2/364 (scipy 1.17.1: 0.005494505494505495).
+    let x = [1.0, 2.0, 3.0];
+    let y: Vec<f64> = (4..=14).map(f64::from).collect();
+    let r = mann_whitney(&x, &y);
+    assert_eq!(r.u, 0.0);
+    assert_eq!(r.method, PMethod::Exact);
+    assert!(close(r.p, 0.005_494_505_494_505_495, 1e-12), "{}", r.p);
+}
+
+#[test]
+fn mann_whitney_normal_with_ties_matches_scipy() {
+    // scipy 1.17.1, mannwhitneyu(x, y) (asymptotic, use_continuity=True, tie-corrected).
+    let cases: [(&[f64], &[f64], f64, f64); 3] = [
+        (
+            &[3.0, 4.0, 2.0, 6.0, 2.0, 5.0],
+            &[9.0, 7.0, 5.0, 10.0, 6.0, 8.0],
+            2.0,
+            0.012_591_911_490_379_705,
+        ),
+        (
+            &[
+                7.0, 7.0, 8.0, 9.0, 9.0, 9.0, 10.0, 12.0, 12.0, 13.0, 14.0, 15.0, 15.0, 15.0, 16.0,
+                18.0, 20.0, 21.0, 21.0, 25.0,
+            ],
+            &[
+                5.0, 6.0, 6.0, 7.0, 8.0, 8.0, 9.0, 10.0, 10.0, 11.0, 11.0, 11.0, 12.0, 13.0, 13.0,
+                14.0, 14.0, 16.0, 17.0, 17.0,
+            ],
+            263.0,
+            0.090_210_168_023_562_66,
+        ),
+        (
+            // Widely separated: x = 0..39, y = x + 25.5 (no ties); p far in the tail.
+            &(0..40).map(f64::from).collect::<Vec<_>>(),
+            &(0..40).map(|v| f64::from(v) + 25.5).collect::<Vec<_>>(),
+            105.0,
+            2.343_724_213_621_403_5e-11,
+        ),
+    ];
+    for (x, y, u, p) in cases {
+        let r = mann_whitney(x, y);
+        assert_eq!(r.method, PMethod::Normal);
+        assert_eq!(r.u, u);
+        assert!(close(r.p, p, 1e-6), "p = {} expected {p}", r.p);
+    }
+}
+
+#[test]
+#[allow(clippy::approx_constant)] // 3.14 is data, not pi.
+fn mann_whitney_nine_against_nine_without_ties_uses_normal() {
+    // Both samples have 9 values: scipy's 'auto' chooses the normal approximation,
+    // scipy 1.17.1 gives (58.0, 0.13291945818531892) (exact would be 0.13591114767585355).
+    let x = [1.83, 0.50, 1.62, 2.48, 1.68, 1.88, 1.55, 3.06, 1.30];
+    let y = [0.878, 0.647, 0.598, 2.05, 1.06, 1.29, 1.06, 3.14, 1.29];
+    let r = mann_whitney(&x, &y);
+    assert_eq!(r.u, 58.0);
+    assert!(close(r.p, 0.132_919_458_185_318_92, 1e-6), "{}", r.p);
+}
+
+#[test]
+fn identical_samples_are_not_different() {
+    let x = [5.0; 10];
+    let r = mann_whitney(&x, &x);
+    assert_eq!(r.p, 1.0);
+    assert_eq!(vargha_delaney(&x, &x), 0.5);
+}
+
+#[test]
+fn holm_adjusts_step_down() {
+    // Holm (1979) step-down by hand: sorted p = .01, .02, .03, .04 with m = 4 become
+    // .04, .06, .06 (monotone), .06; order restored.
+    let adj = holm(&[0.03, 0.01, 0.04, 0.02]);
+    let want = [0.06, 0.04, 0.06, 0.06];
+    for (a, w) in adj.iter().zip(want) {
+        assert!(close(*a, w, 1e-12), "{adj:?}");
+    }
+    // Capped at 1.
+    assert_eq!(holm(&[0.5, 0.6]), vec![1.0, 1.0]);
+}
+
+#[test]
+fn vargha_delaney_counts_wins_and_half_ties() {
+    // Pairs: 3>1, 3>2, 3=3 (1/2); 2>1, 2=2 (1/2), 2<3; 1=1 (1/2), 1<2, 1<3 -> 4.5 of 9 = 0.5.
+    assert_eq!(vargha_delaney(&[1.0, 2.0, 3.0], &[1.0, 2.0, 3.0]), 0.5);
+    // The textbook sample: A = U / (n1 n2) = 17/20.
+    let x = [19.0, 22.0, 16.0, 29.0, 24.0];
+    let y = [20.0, 11.0, 17.0, 12.0];
+    assert!(close(vargha_delaney(&x, &y), 0.85, 1e-12));
+    assert_eq!(Magnitude::of(0.85), Magnitude::Large);
+    assert_eq!(Magnitude::of(0.71), Magnitude::Large);
+    assert_eq!(Magnitude::of(0.70), Magnitude::Medium);
+    assert_eq!(Magnitude::of(0.36), Magnitude::Medium);
+    assert_eq!(Magnitude::of(0.56), Magnitude::Small);
+    assert_eq!(Magnitude::of(0.45), Magnitude::Negligible);
+}
+
+#[test]
+fn bootstrap_interval_covers_shift_and_is_seeded() {
+    let mut rng = ChaCha8Rng::seed_from_u64(SEED);
+    let x: Vec<f64> = (0..200).map(|_| rng.random_range(0.0..1.0) + 2.0).collect();
+    let y: Vec<f64> = (0..200).map(|_| rng.random_range(0.0..1.0)).collect();
+    let (lo, hi) = bootstrap_median_diff_ci(&x, &y, 0.95, 2000, SEED).unwrap();
+    assert!(lo < 2.0 && 2.0 < hi && hi - lo < 0.4, "[{lo}, {hi}]");
+    assert_eq!(
+        bootstrap_median_diff_ci(&x, &y, 0.95, 2000, SEED),
+        Some((lo, hi))
+    );
+    assert_ne!(
+        bootstrap_median_diff_ci(&x, &y, 0.95, 2000, SEED + 1),
+        Some((lo, hi))
+    );
+    assert_eq!(bootstrap_median_diff_ci(&[], &y, 0.95, 2000, SEED), None);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Synthetic results directories.
+
+/// The configurations of the synthetic sweep: the paper's sphere experiment plus greedy.
+const CONFIGS: [(&str, Option<u32>); 6] = [
+    ("greedy", None),
+    ("uniform", Some(1)),
+    ("uniform", Some(2)),
+    ("selective", Some(1)),
+    ("selective", Some(2)),
+    ("selective", Some(3)),
+];
+
+/// One line of `runs.jsonl`: a runner `RunRecord`.
+#[allow(clippy::too_many_arguments)]
+fn record(
+    mesh: &str,
+    algo: &str,
+    horizon: Option<u32>,
+    run: u32,
+    quality_pct: f64,
+    recombined_pct: f64,
+    time_s: f64,
+) -> String {
+    let triangles = 2104usize;
+    let quads = (recombined_pct / 100.0 * triangles as f64 / 2.0).round() as usize;
+    let decisions = quads as u64 + 3;
+    RunRecord {
+        mesh: mesh.to_string(),
+        mesh_hash: "0123456789abcdef0123456789abcdef".to_string(),
+        triangles,
+        algo: algo.to_string(),
+        horizon,
+        seed: 1000 + u64::from(run),
+        run,
+        quads,
+        triangles_left: triangles - 2 * quads,
+        recombined_pct,
+        quality: quality_pct * 9.5,
+        quality_pct: Some(quality_pct),
+        time_s,
+        nodes_expanded: decisions * u64::from(horizon.unwrap_or(1)) * 2,
+        decisions,
+        branching_factor: horizon.filter(|&h| h >= 2).map(|_| 1.5),
+        backend: "cpu-twin".to_string(),
+        version: "0.1.0".to_string(),
+    }
+    .to_json_line()
+}
+
+/// Writes `runs.jsonl` for mesh "sphere": quality rises with the selective horizon, uniform h=2
+/// is worse and much slower, like the paper's Table 1; `shift` moves every quality.
+fn synthetic_dir(dir: &Path, runs: u32, seed: u64, shift: f64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut lines = Vec::new();
+    for (algo, h) in CONFIGS {
+        let (q, r, t) = match (algo, h) {
+            ("greedy", _) => (87.0, 85.0, 0.02),
+            ("uniform", Some(1)) => (87.6, 86.0, 0.16),
+            ("uniform", _) => (85.1, 82.7, 20.0),
+            (_, Some(h)) => (
+                90.8 + h as f64,
+                98.0 + 0.2 * h as f64,
+                0.03 * 1.8f64.powi(h as i32),
+            ),
+            _ => unreachable!(),
+        };
+        for run in 0..runs {
+            let noise = |rng: &mut ChaCha8Rng, s: f64| (rng.random_range(-1.0..1.0)) * s;
+            lines.push(record(
+                "sphere",
+                algo,
+                h,
+                run,
+                q + shift + noise(&mut rng, 0.8),
+                (r + noise(&mut rng, 0.6)).min(100.0),
+                t * (1.0 + noise(&mut rng, 0.2)),
+            ));
+        }
+    }
+    std::fs::write(dir.join("runs.jsonl"), lines.join("\n") + "\n").unwrap();
+}
+
+/// Writes a manifest for the synthetic sphere sweep (optimum quality 950.0).
+fn synthetic_manifest(dir: &Path, runs: u32) {
+    use quadrecomb::experiment::manifest::{Machine, Manifest, MeshEntry, OptimumEntry, SweepSpec};
+    let hash = "0123456789abcdef0123456789abcdef".to_string();
+    Manifest {
+        version: "0.1.0".into(),
+        spec: SweepSpec {
+            meshes: vec![MeshEntry {
+                name: "sphere".into(),
+                source: "sphere".into(),
+                hash: hash.clone(),
+                triangles: 2104,
+            }],
+            algos: vec!["greedy".into(), "uniform".into(), "selective".into()],
+            horizons: vec![1, 2, 3],
+            runs,
+            baseline_runs: runs,
+            seed: SEED,
+        },
+        backend: "cpu-twin".into(),
+        backend_requested: "cpu".into(),
+        optimum: vec![OptimumEntry {
+            mesh: "sphere".into(),
+            mesh_hash: hash,
+            eta_hash: "e".into(),
+            quality: 950.0,
+            quads: 1052,
+            triangles_left: 0,
+            time_s: 0.5,
+        }],
+        shard: None,
+        threads: 2,
+        machine: Machine {
+            cpu: "Test CPU 9000".into(),
+            cores: 2,
+            os: "linux".into(),
+            host: "h".into(),
+        },
+        merged_from: Vec::new(),
+    }
+    .write(dir)
+    .unwrap();
+}
+
+/// Parses an SVG through usvg and renders it through resvg; returns the ids of its elements.
+fn parse_and_render(svg: &str) -> Vec<String> {
+    let tree = resvg::usvg::Tree::from_str(svg, &resvg::usvg::Options::default())
+        .unwrap_or_else(|e| panic!("SVG does not parse: {e}"));
+    let size = tree.size().to_int_size();
+    let mut pixmap = resvg::tiny_skia::Pixmap::new(size.width(), size.height()).unwrap();
+    resvg::render(
+        &tree,
+        resvg::tiny_skia::Transform::default(),
+        &mut pixmap.as_mut(),
+    );
+    // Something was drawn besides the white background.
+    assert!(
+        pixmap
+            .pixels()
+            .iter()
+            .any(|p| p.red() < 200 || p.blue() < 200),
+        "blank rendering"
+    );
+    let mut ids = Vec::new();
+    collect_ids(tree.root(), &mut ids);
+    ids
+}
+
+fn collect_ids(group: &resvg::usvg::Group, ids: &mut Vec<String>) {
+    for node in group.children() {
+        if !node.id().is_empty() {
+            ids.push(node.id().to_string());
+        }
+        if let resvg::usvg::Node::Group(g) = node {
+            collect_ids(g, ids);
+        }
+    }
+}
+
+#[test]
+fn report_names_every_configuration_and_draws_every_box() {
+    let tmp = tempfile::tempdir().unwrap();
+    synthetic_dir(tmp.path(), 30, SEED, 0.0);
+    synthetic_manifest(tmp.path(), 30);
+    let opts = ReportOptions {
+        pictures: false,
+        ..ReportOptions::default()
+    };
+    let paths = report::write(tmp.path(), &opts).unwrap();
+    let md = std::fs::read_to_string(&paths.markdown).unwrap();
+    // The manifest's machine and optimum.
+    assert!(
+        md.contains("Machine: Test CPU 9000 (2 logical cores)"),
+        "{md}"
+    );
+    assert!(
+        md.contains("Optimum quality (maximum-weight matching): 950.0000"),
+        "{md}"
+    );
+    let html = std::fs::read_to_string(&paths.html).unwrap();
+    for (algo, h) in CONFIGS {
+        let label = match h {
+            Some(h) => format!("{algo} h={h}"),
+            None => algo.to_string(),
+        };
+        assert!(md.contains(&label), "report.md lacks {label}");
+        assert!(html.contains(&label), "report.html lacks {label}");
+    }
+    // Table 1 rows: algorithm | horizon | runs.
+    assert!(md.contains("| selective | 3 | 30 |"), "{md}");
+    // The paper's numbers beside ours, labelled.
+    assert!(md.contains("Beside the paper's numbers"));
+    assert!(md.contains(" | 85.1 | "), "{md}");
+    assert!(md.contains("| 225.6 |"), "{md}");
+    assert!(md.contains("different mesh"));
+
+    // Figures: 3 box plots each for uniform and selective.
+    assert_eq!(paths.figures.len(), 6, "{:?}", paths.figures);
+    let mut boxes_seen = 0;
+    for f in &paths.figures {
+        let svg = std::fs::read_to_string(f).unwrap();
+        let ids = parse_and_render(&svg);
+        let boxes: Vec<&String> = ids.iter().filter(|i| i.starts_with("box-h")).collect();
+        let name = f.file_name().unwrap().to_string_lossy();
+        let want: &[&str] = if name.contains("uniform") {
+            &["box-h1", "box-h2"]
+        } else {
+            &["box-h1", "box-h2", "box-h3"]
+        };
+        assert_eq!(boxes, want, "{name}");
+        boxes_seen += boxes.len();
+        // Inlined in the HTML too.
+        assert!(html.contains(svg.lines().nth(1).unwrap_or("")));
+        assert!(md.contains(&format!("figures/{name}")), "{name} not linked");
+    }
+    assert_eq!(boxes_seen, 3 * (2 + 3));
+    // The time plot of selective carries the fitted branching factor.
+    assert!(md.contains("branching factor alpha = 10^slope"));
+}
+
+#[test]
+fn report_states_which_differences_are_significant() {
+    let tmp = tempfile::tempdir().unwrap();
+    synthetic_dir(tmp.path(), 40, SEED, 0.0);
+    let opts = ReportOptions {
+        pictures: false,
+        ..ReportOptions::default()
+    };
+    let paths = report::write(tmp.path(), &opts).unwrap();
+    let md = std::fs::read_to_string(&paths.markdown).unwrap();
+    // Selective quality rises by 1 point per horizon with noise +-0.8: h=2 vs h=1 must be
+    // significant with a large effect; uniform h=2 is far slower than h=1.
+    assert!(
+        md.contains("Consecutive horizons, quality: ") && md.contains("significant at 0.05"),
+        "{md}"
+    );
+    let line = md
+        .lines()
+        .find(|l| l.starts_with("| selective h=2 vs selective h=1 | quality"))
+        .expect("row for selective h=2 vs h=1");
+    assert!(line.ends_with("| yes |"), "{line}");
+    assert!(line.contains("(large)"), "{line}");
+}
+
+#[test]
+fn compare_two_directories() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b, c) = (
+        tmp.path().join("a"),
+        tmp.path().join("b"),
+        tmp.path().join("c"),
+    );
+    for d in [&a, &b, &c] {
+        std::fs::create_dir(d).unwrap();
+    }
+    synthetic_dir(&a, 30, SEED, 0.0);
+    // Same distributions, other seed: nothing should differ in quality.
+    synthetic_dir(&b, 30, SEED + 1, 0.0);
+    // Quality shifted by 3 points: every configuration differs.
+    synthetic_dir(&c, 30, SEED + 2, 3.0);
+    let opts = |other: &Path| ReportOptions {
+        pictures: false,
+        compare: Some(other.to_path_buf()),
+        ..ReportOptions::default()
+    };
+    let md_ab = std::fs::read_to_string(report::write(&a, &opts(&b)).unwrap().markdown).unwrap();
+    assert!(
+        md_ab.contains(
+            "First vs second directory, quality: none of the 6 differences is significant"
+        ),
+        "{md_ab}"
+    );
+    let md_ac = std::fs::read_to_string(report::write(&a, &opts(&c)).unwrap().markdown).unwrap();
+    assert!(
+        md_ac.contains("First vs second directory, quality: 6 of 6 differences are significant"),
+        "{md_ac}"
+    );
+}
+
+#[test]
+fn torn_last_line_is_skipped_and_other_bad_lines_are_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    synthetic_dir(tmp.path(), 5, SEED, 0.0);
+    let runs = tmp.path().join("runs.jsonl");
+    let mut text = std::fs::read_to_string(&runs).unwrap();
+    text.push_str("{\"mesh\": \"sphere\", \"algo\"");
+    std::fs::write(&runs, &text).unwrap();
+    let opts = ReportOptions {
+        pictures: false,
+        ..ReportOptions::default()
+    };
+    let paths = report::write(tmp.path(), &opts).unwrap();
+    let md = std::fs::read_to_string(paths.markdown).unwrap();
+    assert!(md.contains("torn"), "{md}");
+    assert!(md.starts_with("# quadrecomb report"));
+    assert!(md.contains("30 runs in 6 configurations"), "{md}");
+
+    // A bad line in the middle is an error naming the line.
+    std::fs::write(&runs, format!("not json\n{text}")).unwrap();
+    let err = report::write(tmp.path(), &opts).unwrap_err().to_string();
+    assert!(
+        err.contains("runs.jsonl") && err.contains("line 1"),
+        "{err}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Mesh pictures.
+
+/// A 4x3 grid of unit squares, each split into two triangles, in the plane z = 0.
+fn grid_mesh() -> Mesh {
+    let (nx, ny) = (4u32, 3u32);
+    let mut data = MeshData::default();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            data.vertices.push([i as f64, j as f64, 0.0]);
+        }
+    }
+    let v = |i: u32, j: u32| j * (nx + 1) + i;
+    for j in 0..ny {
+        for i in 0..nx {
+            data.triangles.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+            data.triangles.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+        }
+    }
+    Mesh::new(data).unwrap()
+}
+
+/// Counts `<polygon` elements (one per quad or leftover triangle drawn).
+fn polygons(svg: &str) -> usize {
+    svg.matches("<polygon").count()
+}
+
+#[test]
+fn planar_picture_draws_every_quad_and_leftover() {
+    let mesh = grid_mesh();
+    let table = CandidateTable::build(&mesh);
+    // Recombine each square's diagonal pair in the first two rows; leave the third row.
+    let chosen: Vec<u32> = (0..table.len() as u32)
+        .filter(|&c| {
+            let [a, b] = table.pairs[c as usize];
+            a / 2 == b / 2 && a / 8 < 2
+        })
+        .collect();
+    assert_eq!(chosen.len(), 8);
+    let rec = recombined(&mesh, &table, &chosen);
+    let (svg, counts) = mesh_svg(&mesh, &rec, &PictureOptions::default()).unwrap();
+    assert_eq!((counts.quads, counts.leftover, counts.culled), (8, 8, 0));
+    assert_eq!(polygons(&svg), 16);
+    parse_and_render(&svg);
+    // Unit squares have eta 1: the top of viridis; leftovers in red.
+    assert!(svg.contains("#FDE725"), "eta-1 colour missing");
+    assert!(svg.contains("#E61E1E"), "leftover colour missing");
+
+    // Zoom into the lower-left 2x1 cells: 2 quads drawn (the ones touching it are clipped).
+    let zoom = PictureOptions {
+        zoom: Some([0.0, 0.0, 2.0, 1.0]),
+        ..PictureOptions::default()
+    };
+    let (svg, counts) = mesh_svg(&mesh, &rec, &zoom).unwrap();
+    assert_eq!((counts.quads, counts.leftover), (2, 0));
+    assert_eq!(polygons(&svg), 2);
+    parse_and_render(&svg);
+}
+
+#[test]
+fn closed_surface_picture_culls_back_faces() {
+    // Octahedron: from the picture's view direction (1, -1.4, 1.1) four faces face the viewer.
+    let data = MeshData {
+        vertices: vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ],
+        triangles: vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ],
+        ..MeshData::default()
+    };
+    let mesh = Mesh::new(data).unwrap();
+    let table = CandidateTable::build(&mesh);
+    let rec = recombined(&mesh, &table, &[]);
+    let (svg, counts) = mesh_svg(&mesh, &rec, &PictureOptions::default()).unwrap();
+    assert_eq!((counts.leftover, counts.culled), (4, 4));
+    assert_eq!(polygons(&svg), 4);
+    parse_and_render(&svg);
+    // Orientation flipped everywhere: the same faces are culled (outward is detected).
+    let mut flipped = MeshData {
+        vertices: mesh.vertices.clone(),
+        triangles: mesh.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect(),
+        ..MeshData::default()
+    };
+    flipped.triangle_surface = vec![1; 8];
+    let mesh2 = Mesh::new(flipped).unwrap();
+    let rec2 = recombined(&mesh2, &CandidateTable::build(&mesh2), &[]);
+    let (_, counts2) = mesh_svg(&mesh2, &rec2, &PictureOptions::default()).unwrap();
+    assert_eq!(counts2.culled, 4);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The subcommand.
+
+#[test]
+fn report_command_writes_files_and_rejects_bad_input() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("res");
+    std::fs::create_dir(&dir).unwrap();
+    synthetic_dir(&dir, 8, SEED, 0.0);
+    let out = run_in(tmp.path(), &["report", "res", "--no-pictures"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("report.md").is_file() && dir.join("report.html").is_file());
+    assert!(dir.join("figures/sphere-selective-time.svg").is_file());
+
+    let out = run_in(tmp.path(), &["report", "res", "--zoom", "1,2,3"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--zoom"));
+    let out = run_in(tmp.path(), &["report", "missing-dir"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Typical runs, re-run for the pictures.
+
+/// A results directory holding real runs of the built-in sphere (CPU-twin eta), with a
+/// manifest, as a sweep writes it. `tamper` changes the recorded quality of every run.
+fn real_sphere_dir(dir: &Path, tamper: f64) {
+    use quadrecomb::experiment::{mesh_hash, seed::eta_hash};
+    use quadrecomb::gpu::Evaluator;
+    use quadrecomb::search::{self, Algo};
+    let mesh = quadrecomb::mesh::load("sphere").unwrap();
+    let mut table = CandidateTable::topology_only(&mesh);
+    Evaluator::cpu_twin()
+        .fill(&mut [(&mesh, &mut table)])
+        .unwrap();
+    let hash = mesh_hash(&mesh);
+    let mut lines = Vec::new();
+    for (algo, h) in [
+        ("greedy", None),
+        ("selective", Some(1)),
+        ("selective", Some(2)),
+    ] {
+        for run in 0..3u32 {
+            let seed = SEED + 17 * u64::from(run) + u64::from(h.unwrap_or(0));
+            let out = search::run(
+                &mesh,
+                &table,
+                Algo::from_name(algo, h.unwrap_or(1)).unwrap(),
+                seed,
+            );
+            let n = mesh.num_triangles();
+            lines.push(
+                RunRecord {
+                    mesh: "sphere".into(),
+                    mesh_hash: hash.clone(),
+                    triangles: n,
+                    algo: algo.into(),
+                    horizon: h,
+                    seed,
+                    run,
+                    quads: out.quads,
+                    triangles_left: out.triangles_left,
+                    recombined_pct: 100.0 * 2.0 * out.quads as f64 / n as f64,
+                    quality: out.quality + tamper,
+                    quality_pct: None,
+                    time_s: out.time_s,
+                    nodes_expanded: out.nodes_expanded,
+                    decisions: out.decisions,
+                    branching_factor: None,
+                    backend: "cpu-twin".into(),
+                    version: "0.1.0".into(),
+                }
+                .to_json_line(),
+            );
+        }
+    }
+    std::fs::write(dir.join("runs.jsonl"), lines.join("\n") + "\n").unwrap();
+    synthetic_manifest(dir, 3);
+    // The manifest's mesh and eta are the real ones.
+    let path = dir.join("manifest.json");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("0123456789abcdef0123456789abcdef", &hash)
+        .replace(
+            "\"eta_hash\": \"e\"",
+            &format!("\"eta_hash\": \"{}\"", eta_hash(&table.eta)),
+        );
+    std::fs::write(&path, text).unwrap();
+}
+
+#[test]
+fn typical_runs_are_rerun_reproduced_and_drawn() {
+    let tmp = tempfile::tempdir().unwrap();
+    real_sphere_dir(tmp.path(), 0.0);
+    let opts = ReportOptions {
+        zoom: Some([-0.5, -0.5, 0.5, 0.5]),
+        ..ReportOptions::default()
+    };
+    let paths = report::write(tmp.path(), &opts).unwrap();
+    let md = std::fs::read_to_string(&paths.markdown).unwrap();
+    // Default choice: greedy and the best selective horizon; whole and zoomed.
+    let pics: Vec<String> = paths
+        .figures
+        .iter()
+        .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with("-mesh.svg") || n.ends_with("-zoom.svg"))
+        .collect();
+    assert_eq!(pics.len(), 4, "{pics:?}");
+    assert!(
+        pics.contains(&"sphere-greedy-mesh.svg".to_string()),
+        "{pics:?}"
+    );
+    assert!(
+        pics.contains(&"sphere-greedy-zoom.svg".to_string()),
+        "{pics:?}"
+    );
+    assert_eq!(
+        md.matches("the re-run reproduces the recorded quads and quality exactly")
+            .count(),
+        4,
+        "{md}"
+    );
+    assert!(md.contains("its eta hash matches the manifest's"), "{md}");
+    assert!(md.contains("back faces culled"), "{md}");
+    for f in paths
+        .figures
+        .iter()
+        .filter(|f| f.to_string_lossy().ends_with("mesh.svg"))
+    {
+        let svg = std::fs::read_to_string(f).unwrap();
+        parse_and_render(&svg);
+        // About half the sphere faces the viewer.
+        let drawn = polygons(&svg);
+        assert!(drawn > 400 && drawn < 800, "{drawn} faces drawn");
+    }
+
+    // A record the re-run does not reproduce is said so, not hidden.
+    let tmp2 = tempfile::tempdir().unwrap();
+    real_sphere_dir(tmp2.path(), 0.5);
+    let opts = ReportOptions {
+        picture_configs: vec![("selective".into(), Some(2))],
+        ..ReportOptions::default()
+    };
+    let paths = report::write(tmp2.path(), &opts).unwrap();
+    let md = std::fs::read_to_string(&paths.markdown).unwrap();
+    assert!(md.contains("the re-run gives"), "{md}");
+    assert!(
+        tmp2.path()
+            .join("figures/sphere-selective-h-2-mesh.svg")
+            .is_file()
+    );
+}
