@@ -161,13 +161,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         manifest.backend
     );
     if !args.no_report && manifest.shard.is_none() {
-        // LEAD: once the report branch is merged, write the report here:
-        //   let paths = quadrecomb::report::write(&out, &quadrecomb::report::ReportOptions::default())?;
-        //   eprintln!("sweep: report in {}", paths.markdown.display());
-        eprintln!(
-            "sweep: report not written (the report module is not in this build); summary in {}",
-            out.join("summary.csv").display()
-        );
+        let paths = quadrecomb::report::write(&out, &quadrecomb::report::ReportOptions::default())
+            .with_context(|| {
+                format!(
+                    "the sweep's results are complete in {}, but writing its report failed \
+                     (retry with `quadrecomb report {}`)",
+                    out.display(),
+                    out.display()
+                )
+            })?;
+        eprintln!("sweep: report in {}", paths.markdown.display());
     }
     Ok(ExitCode::SUCCESS)
 }

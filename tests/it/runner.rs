@@ -106,7 +106,10 @@ fn threads_and_merged_shards_give_identical_records() {
         );
         assert!(out.status.success(), "{}", stderr(&out));
     }
-    let merged = run_in(dir, &["merge", "s1", "s2", "s3", "--out", "merged"]);
+    let merged = run_in(
+        dir,
+        &["merge", "s1", "s2", "s3", "--out", "merged", "--no-report"],
+    );
     assert!(merged.status.success(), "{}", stderr(&merged));
 
     let a = records(&dir.join("t1"));
@@ -300,7 +303,7 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     other[seed_pos + 1] = "1".into();
     assert!(sweep(dir, &other, &["--shard", "2/2"]).status.success());
 
-    let foreign = run_in(dir, &["merge", "p1", "q2", "--out", "m1"]);
+    let foreign = run_in(dir, &["merge", "p1", "q2", "--out", "m1", "--no-report"]);
     assert_eq!(foreign.status.code(), Some(2));
     assert!(
         stderr(&foreign).contains("not parts of the same sweep"),
@@ -309,18 +312,48 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     );
     assert!(stderr(&foreign).contains("seed"), "{}", stderr(&foreign));
 
-    let missing = run_in(dir, &["merge", "p1", "--out", "m2"]);
+    let missing = run_in(dir, &["merge", "p1", "--out", "m2", "--no-report"]);
     assert_eq!(missing.status.code(), Some(2));
     assert!(stderr(&missing).contains("missing"), "{}", stderr(&missing));
 
-    let dup = run_in(dir, &["merge", "p1", "p2", "p2", "--out", "m3"]);
+    let dup = run_in(
+        dir,
+        &["merge", "p1", "p2", "p2", "--out", "m3", "--no-report"],
+    );
     assert_eq!(dup.status.code(), Some(2));
     assert!(stderr(&dup).contains("is in both"), "{}", stderr(&dup));
 
+    // A successful merge writes the report of the merged results.
     let ok = run_in(dir, &["merge", "p1", "p2", "--out", "m4"]);
     assert!(ok.status.success(), "{}", stderr(&ok));
+    assert!(dir.join("m4/report.md").exists());
     // 2 horizons x 3 runs of selective + 2 greedy + 2 greedy-nocrit + 1 optimum.
     assert_eq!(records(&dir.join("m4")).len(), 2 * 3 + 2 + 2 + 1);
+}
+
+#[test]
+fn sweep_writes_summary_and_report_by_default() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 400);
+    let args: Vec<String> = sweep_args(&mesh, "rep", 3, "1..2")
+        .into_iter()
+        .filter(|a| a != "--no-report")
+        .collect();
+    let out = sweep(dir, &args, &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for f in [
+        "runs.jsonl",
+        "manifest.json",
+        "summary.csv",
+        "summary.json",
+        "report.md",
+    ] {
+        assert!(dir.join("rep").join(f).exists(), "{f} missing");
+    }
+    let csv = std::fs::read_to_string(dir.join("rep/summary.csv")).unwrap();
+    assert!(csv.contains("small,selective,2,quality_pct,3,"), "{csv}");
+    assert!(csv.contains("small,optimum,,quality_pct,1,100,"), "{csv}");
 }
 
 #[test]
