@@ -268,6 +268,14 @@ fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
         .unwrap();
     let runs = dir.join("int/runs.jsonl");
     assert!(wait_for_lines(&runs, 10, Duration::from_secs(60)) >= 10);
+    // A second sweep into the same directory while the first runs is refused.
+    let second = sweep(dir, &args, &["--resume"]);
+    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert!(
+        stderr(&second).contains("another sweep"),
+        "{}",
+        stderr(&second)
+    );
     let kill = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
@@ -282,6 +290,55 @@ fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
     let resumed = sweep(dir, &args, &["--resume", "--threads", "2"]);
     assert!(resumed.status.success(), "{}", stderr(&resumed));
     assert_eq!(records(&dir.join("int")).len(), total);
+}
+
+#[test]
+fn a_second_sweep_into_a_busy_directory_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    // Long enough to still be running when the second one starts; killed at the end.
+    let args = sweep_args(&mesh, "busy", 5000, "1..4");
+    let mut first = Command::new(bin())
+        .args(&args)
+        .args(["--threads", "1"])
+        .current_dir(dir)
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let runs = dir.join("busy/runs.jsonl");
+    assert!(wait_for_lines(&runs, 2, Duration::from_secs(60)) >= 2);
+    let second = sweep(dir, &args, &["--resume"]);
+    let still_running = first.try_wait().unwrap().is_none();
+    first.kill().unwrap();
+    first.wait().unwrap();
+    assert!(
+        still_running,
+        "the first sweep ended too early for this test"
+    );
+    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert!(
+        stderr(&second).contains("another sweep"),
+        "{}",
+        stderr(&second)
+    );
+    // Once the writer is gone (killed, leaving a stale lock), the lock is taken over: what
+    // stops this resume is now its different shard, not the lock.
+    let resumed = sweep(
+        dir,
+        &sweep_args(&mesh, "busy", 5000, "1..4"),
+        &["--resume", "--shard", "1/1"],
+    );
+    assert_eq!(
+        resumed.status.code(),
+        Some(2),
+        "a shard of another list is refused"
+    );
+    assert!(
+        stderr(&resumed).contains("shard 1/1 vs the whole run list"),
+        "{}",
+        stderr(&resumed)
+    );
 }
 
 #[test]
