@@ -106,6 +106,10 @@ pub struct Stats {
     pub dummies: usize,
     /// Heap events popped.
     pub events: usize,
+    /// Leaves scanned (edges out of plus leaves pushed as events).
+    pub scans: usize,
+    /// Leaves rescanned (after leaving a tree).
+    pub rescans: usize,
 }
 
 /// A solved matching with its dual certificate.
@@ -480,6 +484,34 @@ impl Solver {
                 }
             }
         }
+        // Augmenting paths of length three along tight edges: free v, w = x, free z.
+        for v in 0..self.n as u32 {
+            if self.mate[v as usize] != NONE {
+                continue;
+            }
+            let yv = self.dual[v as usize];
+            'found: for k in g.adj(v) {
+                let w = g.nbr[k];
+                let x = self.mate[w as usize];
+                if x == NONE || self.cost_k(g, k) != yv + self.dual[w as usize] {
+                    continue;
+                }
+                let yx = self.dual[x as usize];
+                for k2 in g.adj(x) {
+                    let z = g.nbr[k2];
+                    if z != v
+                        && self.mate[z as usize] == NONE
+                        && self.cost_k(g, k2) == yx + self.dual[z as usize]
+                    {
+                        self.mate[v as usize] = w;
+                        self.mate[w as usize] = v;
+                        self.mate[x as usize] = z;
+                        self.mate[z as usize] = x;
+                        break 'found;
+                    }
+                }
+            }
+        }
     }
 
     /// Adds a dummy vertex to component `c`, joined to all its vertices at cost 0, with the
@@ -507,8 +539,10 @@ impl Solver {
             for k in g.adj(v) {
                 f(self, g.nbr[k], self.cost_k(g, k));
             }
-            for &d in &self.comp_dummies[self.comp[v as usize] as usize] {
-                f(self, d, 0);
+            if self.stats.dummies > 0 {
+                for &d in &self.comp_dummies[self.comp[v as usize] as usize] {
+                    f(self, d, 0);
+                }
             }
         } else {
             let c = self.comp[v as usize] as usize;
@@ -542,6 +576,7 @@ impl Solver {
 
     /// Pushes events for every edge out of plus leaf `v`.
     fn scan(&mut self, g: &Graph, v: u32) {
+        self.stats.scans += 1;
         let yv = self.yact(v);
         let mut heap = std::mem::take(&mut self.heap);
         self.for_neighbours(g, v, |s, w, c| {
@@ -554,6 +589,7 @@ impl Solver {
 
     /// Pushes events for every edge from a plus leaf into leaf `w` (which just left the tree).
     fn rescan_into(&mut self, g: &Graph, w: u32) {
+        self.stats.rescans += 1;
         let mut heap = std::mem::take(&mut self.heap);
         self.for_neighbours(g, w, |s, v, c| {
             if s.label[s.top(v) as usize] == PLUS
@@ -629,10 +665,18 @@ impl Solver {
                 }
                 continue;
             }
-            let (v, w) = (a, b);
-            let (tv, tw) = (self.top(v), self.top(w));
-            if tv == tw || self.label[tv as usize] != PLUS {
+            // Events are kept from either end: a plus end that left the tree hands over.
+            let (mut v, mut w) = (a, b);
+            let (mut tv, mut tw) = (self.top(v), self.top(w));
+            if tv == tw {
                 continue;
+            }
+            if self.label[tv as usize] != PLUS {
+                if self.label[tw as usize] != PLUS {
+                    continue;
+                }
+                std::mem::swap(&mut v, &mut w);
+                std::mem::swap(&mut tv, &mut tw);
             }
             let lw = self.label[tw as usize];
             if lw == MINUS {
@@ -711,8 +755,8 @@ impl Solver {
         }
     }
 
-    /// Ends tree `t` after its augmentation: materializes its duals, frees its nodes and adds
-    /// the events from the remaining trees into them.
+    /// Ends tree `t` after its augmentation: folds its duals, frees its nodes and adds the
+    /// events from the remaining trees into its former minus nodes.
     fn dissolve(&mut self, g: &Graph, t: u32) {
         self.tree_alive[t as usize] = false;
         self.alive -= 1;
@@ -726,9 +770,14 @@ impl Solver {
             {
                 continue;
             }
+            // Edges from other trees into former plus leaves already have (early) events;
+            // edges into former minus leaves had none.
+            let was_minus = self.label[x as usize] == MINUS;
             self.freeze(x);
             self.label[x as usize] = FREE;
-            self.leaves_into(x, &mut leaves);
+            if was_minus {
+                self.leaves_into(x, &mut leaves);
+            }
         }
         for &v in &leaves {
             self.rescan_into(g, v);
@@ -971,43 +1020,55 @@ impl Solver {
     /// every enclosing cycle (no recursion: a work stack).
     fn rotate(&mut self, b: u32, v: u32) {
         let mut stack = vec![(b, v)];
+        let mut chain = Vec::new();
         while let Some((b, v)) = stack.pop() {
+            // The blossoms from `b` down to `v`, each rotated once.
+            chain.clear();
             let mut t = v;
-            while self.parent[t as usize] != b {
+            while t != b {
+                chain.push(t);
                 t = self.parent[t as usize];
             }
-            if self.is_blossom(t) {
-                stack.push((t, v));
+            let mut x = b;
+            for &t in chain.iter().rev() {
+                self.rotate_level(x, t, &mut stack);
+                self.base[x as usize] = v;
+                x = t;
             }
-            let bi = b as usize - self.n;
-            let k = self.children[bi].len();
-            let i = self.children[bi]
-                .iter()
-                .position(|&c| c == t)
-                .expect("child");
-            if i != 0 {
-                let js: Vec<usize> = if i % 2 == 0 {
-                    (0..i - 1).step_by(2).collect()
-                } else {
-                    (i + 1..k).step_by(2).collect()
-                };
-                for j in js {
-                    let [a, c] = self.cedges[bi][j];
-                    let (ca, cc) = (self.children[bi][j], self.children[bi][(j + 1) % k]);
-                    self.mate[a as usize] = c;
-                    self.mate[c as usize] = a;
-                    if self.is_blossom(ca) {
-                        stack.push((ca, a));
-                    }
-                    if self.is_blossom(cc) {
-                        stack.push((cc, c));
-                    }
-                }
-                self.children[bi].rotate_left(i);
-                self.cedges[bi].rotate_left(i);
-            }
-            self.base[b as usize] = v;
         }
+    }
+
+    /// Rotates the cycle of blossom `b` so that its child `t` comes first, rematching the
+    /// even path; sub-blossoms whose base changes go on `stack`.
+    fn rotate_level(&mut self, b: u32, t: u32, stack: &mut Vec<(u32, u32)>) {
+        let bi = b as usize - self.n;
+        let k = self.children[bi].len();
+        let i = self.children[bi]
+            .iter()
+            .position(|&c| c == t)
+            .expect("child");
+        if i == 0 {
+            return;
+        }
+        let js = if i % 2 == 0 {
+            (0..i - 1).step_by(2)
+        } else {
+            (i + 1..k).step_by(2)
+        };
+        for j in js {
+            let [a, c] = self.cedges[bi][j];
+            let (ca, cc) = (self.children[bi][j], self.children[bi][(j + 1) % k]);
+            self.mate[a as usize] = c;
+            self.mate[c as usize] = a;
+            if self.is_blossom(ca) {
+                stack.push((ca, a));
+            }
+            if self.is_blossom(cc) {
+                stack.push((cc, c));
+            }
+        }
+        self.children[bi].rotate_left(i);
+        self.cedges[bi].rotate_left(i);
     }
 
     fn check(&self, g: &Graph) -> Result<CheckReport, String> {
@@ -1173,35 +1234,5 @@ impl Solver {
             }
         }
         (a != NONE).then_some(a)
-    }
-}
-
-impl Matching {
-    /// Temporary: (max nesting depth, max blossom size, sum of top-level blossom sizes).
-    pub fn shape(&self) -> (usize, usize, usize) {
-        let s = &self.s;
-        let mut maxd = 0;
-        for v in 0..s.n {
-            let mut d = 0;
-            let mut x = s.parent[v];
-            while x != NONE {
-                d += 1;
-                x = s.parent[x as usize];
-            }
-            maxd = maxd.max(d);
-        }
-        let mut maxs = 0;
-        let mut tot = 0;
-        for b in s.n..s.parent.len() {
-            if s.is_blossom(b as u32) {
-                let mut l = Vec::new();
-                s.leaves_into(b as u32, &mut l);
-                maxs = maxs.max(l.len());
-                if s.parent[b] == NONE {
-                    tot += l.len();
-                }
-            }
-        }
-        (maxd, maxs, tot)
     }
 }
