@@ -819,3 +819,40 @@ fn fuzz_regressions() {
     }
     assert!(n > 0, "no regression inputs in {}", dir.display());
 }
+
+#[test]
+fn bench_io_reports_each_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = data("two_squares_41_bin.msh");
+    let b = data("mixed_22_ascii.msh");
+    let out = run_in(
+        dir.path(),
+        &[
+            "bench",
+            "io",
+            "--reps",
+            "3",
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+        ],
+    );
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{s}");
+    let rows: Vec<&str> = s.lines().filter(|l| l.contains(".msh")).collect();
+    assert_eq!(rows.len(), 2, "{s}");
+    assert!(
+        rows[0].contains("msh 4.1 binary") && rows[0].contains(" 44 "),
+        "{s}"
+    );
+    assert!(
+        rows[1].contains("msh 2.2 ascii") && rows[1].contains(" 22 "),
+        "{s}"
+    );
+    let bad = run_in(
+        dir.path(),
+        &["bench", "io", "--reps", "0", a.to_str().unwrap()],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    let missing = run_in(dir.path(), &["bench", "io", "no_such.msh"]);
+    assert_eq!(missing.status.code(), Some(2));
+}
