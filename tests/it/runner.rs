@@ -167,9 +167,10 @@ fn wait_for_lines(path: &Path, lines: usize, limit: Duration) -> usize {
 fn kill_9_then_resume_equals_an_uninterrupted_sweep() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let mesh = small_mesh(dir, 600);
-    let args = sweep_args(&mesh, "killed", 40, "1..4");
-    let total = 4 * 40 + 2 + 2 + 1;
+    // About 600 runs: long enough (seconds) to be killed after 20 of them.
+    let mesh = small_mesh(dir, 1000);
+    let args = sweep_args(&mesh, "killed", 100, "1..6");
+    let total = 6 * 100 + 2 + 2 + 1;
     let mut child = Command::new(bin())
         .args(&args)
         .args(["--threads", "2"])
@@ -192,7 +193,7 @@ fn kill_9_then_resume_equals_an_uninterrupted_sweep() {
 
     let full = sweep(
         dir,
-        &sweep_args(&mesh, "full", 40, "1..4"),
+        &sweep_args(&mesh, "full", 100, "1..6"),
         &["--threads", "2"],
     );
     assert!(full.status.success(), "{}", stderr(&full));
@@ -256,9 +257,9 @@ fn torn_last_line_is_redone_on_resume_and_fresh_sweep_refuses_a_used_dir() {
 fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let mesh = small_mesh(dir, 600);
-    let args = sweep_args(&mesh, "int", 40, "1..4");
-    let total = 4 * 40 + 2 + 2 + 1;
+    let mesh = small_mesh(dir, 1000);
+    let args = sweep_args(&mesh, "int", 100, "1..6");
+    let total = 6 * 100 + 2 + 2 + 1;
     let child = Command::new(bin())
         .args(&args)
         .args(["--threads", "2"])
