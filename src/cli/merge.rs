@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use anyhow::Context;
 use quadrecomb::experiment::merge::merge;
 
 #[derive(Debug, clap::Args)]
@@ -13,6 +14,9 @@ pub struct Args {
     /// Directory to write the merged results into (must not hold runs yet).
     #[arg(long)]
     out: PathBuf,
+    /// Do not write the report of the merged results.
+    #[arg(long)]
+    no_report: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -23,5 +27,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         merged.parts,
         args.out.display()
     );
+    if !args.no_report {
+        let out = &args.out;
+        let paths = quadrecomb::report::write(out, &quadrecomb::report::ReportOptions::default())
+            .with_context(|| {
+            format!(
+                "the merged results are complete in {}, but writing their report failed \
+                     (retry with `quadrecomb report {}`)",
+                out.display(),
+                out.display()
+            )
+        })?;
+        eprintln!("merge: report in {}", paths.markdown.display());
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -16,7 +16,7 @@ pub struct Args {
     #[arg(long, value_name = "x0,y0,x1,y1")]
     zoom: Option<String>,
     /// Picture the typical run of this configuration, e.g. `selective:5` or `greedy`
-    /// (repeatable; default: greedy and the best horizon of each look-ahead algorithm).
+    /// (repeatable; default: the best horizon of each look-ahead algorithm).
     #[arg(long = "picture", value_name = "ALGO[:H]")]
     pictures: Vec<String>,
     /// Leave out the mesh pictures (they re-run each typical run).

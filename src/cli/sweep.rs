@@ -43,7 +43,8 @@ pub struct Args {
     /// Who computes the quad qualities.
     #[arg(long, value_enum, default_value_t = Backend::Auto)]
     backend: Backend,
-    /// Results directory (default: results/<mesh> for one mesh, results/sweep otherwise).
+    /// Results directory (default: results/<mesh> for one mesh, results/sweep otherwise;
+    /// with --shard I/N, results/<mesh>-shard-I-of-N).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Continue the sweep in --out, skipping the runs it already recorded.
@@ -99,9 +100,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         args.meshes
     };
-    let out = args.out.unwrap_or_else(|| match meshes.as_slice() {
-        [one] => PathBuf::from("results").join(sweep::mesh_name(one)),
-        _ => PathBuf::from("results/sweep"),
+    let out = args.out.unwrap_or_else(|| {
+        let base = match meshes.as_slice() {
+            [one] => sweep::mesh_name(one),
+            _ => "sweep".to_string(),
+        };
+        // Shards get a directory each, so that they never share a run log.
+        let name = match args.shard {
+            Some(s) => format!("{base}-shard-{}-of-{}", s.index, s.count),
+            None => base,
+        };
+        PathBuf::from("results").join(name)
     });
     let config = SweepConfig {
         meshes,
@@ -161,13 +170,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         manifest.backend
     );
     if !args.no_report && manifest.shard.is_none() {
-        // LEAD: once the report branch is merged, write the report here:
-        //   let paths = quadrecomb::report::write(&out, &quadrecomb::report::ReportOptions::default())?;
-        //   eprintln!("sweep: report in {}", paths.markdown.display());
-        eprintln!(
-            "sweep: report not written (the report module is not in this build); summary in {}",
-            out.join("summary.csv").display()
-        );
+        let paths = quadrecomb::report::write(&out, &quadrecomb::report::ReportOptions::default())
+            .with_context(|| {
+                format!(
+                    "the sweep's results are complete in {}, but writing its report failed \
+                     (retry with `quadrecomb report {}`)",
+                    out.display(),
+                    out.display()
+                )
+            })?;
+        eprintln!("sweep: report in {}", paths.markdown.display());
     }
     Ok(ExitCode::SUCCESS)
 }

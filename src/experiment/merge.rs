@@ -44,7 +44,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
         }
     }
     let jobs = plan(&first.spec);
-    let mut by_key: BTreeMap<RunKey, (RunRecord, usize)> = BTreeMap::new();
+    let mut by_key: BTreeMap<RunKey, (RunRecord, String, usize)> = BTreeMap::new();
     let mut merged_from = Vec::new();
     for (i, (p, m)) in parts.iter().zip(&manifests).enumerate() {
         let loaded = store::read(&p.join(RUNS_FILE))?;
@@ -57,8 +57,8 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
         // Every record must be a run of the whole list with the right seed (a shard's records
         // are runs of the whole list too).
         check_records(p, m, &jobs, &loaded.records)?;
-        for r in &loaded.records {
-            if let Some((_, j)) = by_key.get(&r.key()) {
+        for (r, line) in loaded.records.iter().zip(&loaded.lines) {
+            if let Some((_, _, j)) = by_key.get(&r.key()) {
                 return Err(ExperimentError::Merge(format!(
                     "run {} is in both {} and {}",
                     r.key(),
@@ -66,7 +66,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
                     p.display()
                 )));
             }
-            by_key.insert(r.key(), (r.clone(), i));
+            by_key.insert(r.key(), (r.clone(), line.clone(), i));
         }
         merged_from.push(MergedPart {
             dir: p.display().to_string(),
@@ -108,10 +108,10 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     let mut log = RunLog::create(&out_runs)?;
     let mut records = Vec::with_capacity(jobs.len());
     for j in &jobs {
-        let (r, _) = by_key
+        let (r, line, _) = by_key
             .remove(&j.key(&first.spec))
             .expect("checked: none missing");
-        log.append(&r)?;
+        log.append_line(&line)?;
         records.push(r);
     }
     log.sync()?;
@@ -168,6 +168,17 @@ mod tests {
         let b = sorted(&out);
         assert_eq!(a.len(), b.len());
         assert!(a.iter().zip(&b).all(|(x, y)| x.same_result(y)));
+        // Lines are copied byte for byte.
+        let lines = |d: &Path| -> std::collections::BTreeSet<String> {
+            std::fs::read_to_string(d.join(RUNS_FILE))
+                .unwrap()
+                .lines()
+                .map(String::from)
+                .collect()
+        };
+        let union: std::collections::BTreeSet<String> =
+            parts.iter().flat_map(|p| lines(p)).collect();
+        assert_eq!(lines(&out), union);
         let man = Manifest::read(&out).unwrap();
         assert_eq!(man.merged_from.len(), 3);
         assert!(man.shard.is_none());

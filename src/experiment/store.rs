@@ -20,6 +20,9 @@ pub const RUNS_FILE: &str = "runs.jsonl";
 pub struct Loaded {
     /// Complete, parsed records, in file order.
     pub records: Vec<RunRecord>,
+    /// The lines the records were parsed from (without newline), to copy them exactly: JSON
+    /// float parsing may be off by an ulp, so re-serializing a parsed record could change it.
+    pub lines: Vec<String>,
     /// Length in bytes of the complete lines (where appending resumes).
     pub valid_len: u64,
     /// Bytes of a torn last line (no newline), ignored; 0 if none.
@@ -35,6 +38,7 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
     };
     let valid_len = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     let mut records = Vec::new();
+    let mut lines = Vec::new();
     for (n, line) in bytes[..valid_len].split(|&b| b == b'\n').enumerate() {
         if line.iter().all(u8::is_ascii_whitespace) {
             continue;
@@ -45,9 +49,11 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
                 message: format!("line {}: {e}", n + 1),
             })?;
         records.push(rec);
+        lines.push(String::from_utf8_lossy(line).into_owned());
     }
     Ok(Loaded {
         records,
+        lines,
         valid_len: valid_len as u64,
         torn_bytes: (bytes.len() - valid_len) as u64,
     })
@@ -94,7 +100,12 @@ impl RunLog {
 
     /// Appends one record as one line, in one write, and flushes it to the OS.
     pub fn append(&mut self, rec: &RunRecord) -> Result<(), ExperimentError> {
-        let mut line = rec.to_json_line();
+        self.append_line(&rec.to_json_line())
+    }
+
+    /// Appends a line already serialized (from another run log), newline added.
+    pub fn append_line(&mut self, line: &str) -> Result<(), ExperimentError> {
+        let mut line = line.to_string();
         line.push('\n');
         self.file
             .write_all(line.as_bytes())

@@ -222,11 +222,14 @@ pub fn cached_optimum(
     let path = dir.join(format!("{}.json", entry.hash));
     let eta = eta_hash(&table.eta);
     if let Ok(text) = std::fs::read_to_string(&path) {
-        if let Ok(cached) = serde_json::from_str::<OptimumEntry>(&text) {
-            if cached.mesh_hash == entry.hash && cached.eta_hash == eta {
+        if let Ok(cached) = serde_json::from_str::<CachedOptimum>(&text) {
+            if cached.optimum.mesh_hash == entry.hash && cached.optimum.eta_hash == eta {
                 return Ok(OptimumEntry {
                     mesh: entry.name.clone(),
-                    ..cached
+                    // JSON parsing of floats may be off by an ulp: restore the exact value,
+                    // so that quality_pct is bit-identical whether the optimum was cached.
+                    quality: f64::from_bits(cached.quality_bits),
+                    ..cached.optimum
                 });
             }
         }
@@ -242,9 +245,20 @@ pub fn cached_optimum(
         time_s: opt.time_s,
     };
     std::fs::create_dir_all(&dir).map_err(|e| ExperimentError::io(&dir, e))?;
-    let text = serde_json::to_string_pretty(&found).expect("serializes");
+    let cached = CachedOptimum {
+        quality_bits: found.quality.to_bits(),
+        optimum: found.clone(),
+    };
+    let text = serde_json::to_string_pretty(&cached).expect("serializes");
     super::write_atomic(&path, format!("{text}\n").as_bytes())?;
     Ok(found)
+}
+
+/// An optimum cache file: the entry and the exact bits of its quality.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+struct CachedOptimum {
+    optimum: OptimumEntry,
+    quality_bits: u64,
 }
 
 /// Runs searches (and reports the precomputed optimum) for the engine.

@@ -1,6 +1,6 @@
 //! Reports: tables, box plots, mesh pictures and statistical comparisons from sweep results.
 //!
-//! [`write`] reads a results directory (`runs.jsonl`, `manifest.json`) and writes `report.md`,
+//! [`write()`] reads a results directory (`runs.jsonl`, `manifest.json`) and writes `report.md`,
 //! `report.html` (figures inlined) and the figures as SVG files under `figures/`. The report
 //! holds, per mesh: a Table-1-style table (median quality % of optimum, recombined %, time,
 //! nodes per step per algorithm and horizon), the paper's own numbers beside ours, Fig.-8-style
@@ -60,8 +60,8 @@ pub struct ReportOptions {
     pub zoom: Option<[f64; 4]>,
     /// Draw mesh pictures of typical runs (re-running them).
     pub pictures: bool,
-    /// Configurations (algorithm, horizon) whose typical run is pictured; empty: greedy and,
-    /// per look-ahead algorithm, the horizon with the best median quality.
+    /// Configurations (algorithm, horizon) whose typical run is pictured; empty: per look-ahead
+    /// algorithm, the horizon with the best median quality.
     pub picture_configs: Vec<(String, Option<u32>)>,
     /// Seed of the bootstrap resampling.
     pub seed: u64,
@@ -495,11 +495,7 @@ fn picture_choice<'a>(
             .copied()
             .collect();
     }
-    let mut out: Vec<(&Config, &[Run])> = configs
-        .iter()
-        .filter(|(c, _)| c.algo == "greedy")
-        .copied()
-        .collect();
+    let mut out: Vec<(&Config, &[Run])> = Vec::new();
     let mut algos: Vec<&str> = configs
         .iter()
         .filter(|(c, _)| c.horizon.is_some())

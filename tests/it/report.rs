@@ -670,15 +670,27 @@ fn typical_runs_are_rerun_reproduced_and_drawn() {
         ..ReportOptions::default()
     };
     let paths = report::write(tmp.path(), &opts).unwrap();
+    let default_pics = paths
+        .figures
+        .iter()
+        .filter(|f| f.to_string_lossy().contains("-h-2-"))
+        .count();
+    assert_eq!(default_pics, 2, "{:?}", paths.figures);
+    let opts = ReportOptions {
+        picture_configs: vec![("greedy".into(), None), ("selective".into(), None)],
+        ..opts
+    };
+    let paths = report::write(tmp.path(), &opts).unwrap();
     let md = std::fs::read_to_string(&paths.markdown).unwrap();
-    // Default choice: greedy and the best selective horizon; whole and zoomed.
+    // Default choice: the best selective horizon (h=2 here); whole and zoomed. Greedy asked for.
     let pics: Vec<String> = paths
         .figures
         .iter()
         .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
         .filter(|n| n.ends_with("-mesh.svg") || n.ends_with("-zoom.svg"))
         .collect();
-    assert_eq!(pics.len(), 4, "{pics:?}");
+    // greedy, selective h=1 and h=2 (ALGO without :H means every horizon), whole and zoomed.
+    assert_eq!(pics.len(), 6, "{pics:?}");
     assert!(
         pics.contains(&"sphere-greedy-mesh.svg".to_string()),
         "{pics:?}"
@@ -690,7 +702,7 @@ fn typical_runs_are_rerun_reproduced_and_drawn() {
     assert_eq!(
         md.matches("the re-run reproduces the recorded quads and quality exactly")
             .count(),
-        4,
+        6,
         "{md}"
     );
     assert!(md.contains("its eta hash matches the manifest's"), "{md}");

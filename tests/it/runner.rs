@@ -106,7 +106,10 @@ fn threads_and_merged_shards_give_identical_records() {
         );
         assert!(out.status.success(), "{}", stderr(&out));
     }
-    let merged = run_in(dir, &["merge", "s1", "s2", "s3", "--out", "merged"]);
+    let merged = run_in(
+        dir,
+        &["merge", "s1", "s2", "s3", "--out", "merged", "--no-report"],
+    );
     assert!(merged.status.success(), "{}", stderr(&merged));
 
     let a = records(&dir.join("t1"));
@@ -164,9 +167,10 @@ fn wait_for_lines(path: &Path, lines: usize, limit: Duration) -> usize {
 fn kill_9_then_resume_equals_an_uninterrupted_sweep() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let mesh = small_mesh(dir, 600);
-    let args = sweep_args(&mesh, "killed", 40, "1..4");
-    let total = 4 * 40 + 2 + 2 + 1;
+    // About 600 runs: long enough (seconds) to be killed after 20 of them.
+    let mesh = small_mesh(dir, 1000);
+    let args = sweep_args(&mesh, "killed", 100, "1..6");
+    let total = 6 * 100 + 2 + 2 + 1;
     let mut child = Command::new(bin())
         .args(&args)
         .args(["--threads", "2"])
@@ -189,7 +193,7 @@ fn kill_9_then_resume_equals_an_uninterrupted_sweep() {
 
     let full = sweep(
         dir,
-        &sweep_args(&mesh, "full", 40, "1..4"),
+        &sweep_args(&mesh, "full", 100, "1..6"),
         &["--threads", "2"],
     );
     assert!(full.status.success(), "{}", stderr(&full));
@@ -253,9 +257,9 @@ fn torn_last_line_is_redone_on_resume_and_fresh_sweep_refuses_a_used_dir() {
 fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let mesh = small_mesh(dir, 600);
-    let args = sweep_args(&mesh, "int", 40, "1..4");
-    let total = 4 * 40 + 2 + 2 + 1;
+    let mesh = small_mesh(dir, 1000);
+    let args = sweep_args(&mesh, "int", 100, "1..6");
+    let total = 6 * 100 + 2 + 2 + 1;
     let child = Command::new(bin())
         .args(&args)
         .args(["--threads", "2"])
@@ -265,6 +269,14 @@ fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
         .unwrap();
     let runs = dir.join("int/runs.jsonl");
     assert!(wait_for_lines(&runs, 10, Duration::from_secs(60)) >= 10);
+    // A second sweep into the same directory while the first runs is refused.
+    let second = sweep(dir, &args, &["--resume"]);
+    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert!(
+        stderr(&second).contains("another sweep"),
+        "{}",
+        stderr(&second)
+    );
     let kill = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
@@ -279,6 +291,55 @@ fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
     let resumed = sweep(dir, &args, &["--resume", "--threads", "2"]);
     assert!(resumed.status.success(), "{}", stderr(&resumed));
     assert_eq!(records(&dir.join("int")).len(), total);
+}
+
+#[test]
+fn a_second_sweep_into_a_busy_directory_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    // Long enough to still be running when the second one starts; killed at the end.
+    let args = sweep_args(&mesh, "busy", 5000, "1..4");
+    let mut first = Command::new(bin())
+        .args(&args)
+        .args(["--threads", "1"])
+        .current_dir(dir)
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let runs = dir.join("busy/runs.jsonl");
+    assert!(wait_for_lines(&runs, 2, Duration::from_secs(60)) >= 2);
+    let second = sweep(dir, &args, &["--resume"]);
+    let still_running = first.try_wait().unwrap().is_none();
+    first.kill().unwrap();
+    first.wait().unwrap();
+    assert!(
+        still_running,
+        "the first sweep ended too early for this test"
+    );
+    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert!(
+        stderr(&second).contains("another sweep"),
+        "{}",
+        stderr(&second)
+    );
+    // Once the writer is gone (killed, leaving a stale lock), the lock is taken over: what
+    // stops this resume is now its different shard, not the lock.
+    let resumed = sweep(
+        dir,
+        &sweep_args(&mesh, "busy", 5000, "1..4"),
+        &["--resume", "--shard", "1/1"],
+    );
+    assert_eq!(
+        resumed.status.code(),
+        Some(2),
+        "a shard of another list is refused"
+    );
+    assert!(
+        stderr(&resumed).contains("shard 1/1 vs the whole run list"),
+        "{}",
+        stderr(&resumed)
+    );
 }
 
 #[test]
@@ -300,7 +361,7 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     other[seed_pos + 1] = "1".into();
     assert!(sweep(dir, &other, &["--shard", "2/2"]).status.success());
 
-    let foreign = run_in(dir, &["merge", "p1", "q2", "--out", "m1"]);
+    let foreign = run_in(dir, &["merge", "p1", "q2", "--out", "m1", "--no-report"]);
     assert_eq!(foreign.status.code(), Some(2));
     assert!(
         stderr(&foreign).contains("not parts of the same sweep"),
@@ -309,18 +370,48 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     );
     assert!(stderr(&foreign).contains("seed"), "{}", stderr(&foreign));
 
-    let missing = run_in(dir, &["merge", "p1", "--out", "m2"]);
+    let missing = run_in(dir, &["merge", "p1", "--out", "m2", "--no-report"]);
     assert_eq!(missing.status.code(), Some(2));
     assert!(stderr(&missing).contains("missing"), "{}", stderr(&missing));
 
-    let dup = run_in(dir, &["merge", "p1", "p2", "p2", "--out", "m3"]);
+    let dup = run_in(
+        dir,
+        &["merge", "p1", "p2", "p2", "--out", "m3", "--no-report"],
+    );
     assert_eq!(dup.status.code(), Some(2));
     assert!(stderr(&dup).contains("is in both"), "{}", stderr(&dup));
 
+    // A successful merge writes the report of the merged results.
     let ok = run_in(dir, &["merge", "p1", "p2", "--out", "m4"]);
     assert!(ok.status.success(), "{}", stderr(&ok));
+    assert!(dir.join("m4/report.md").exists());
     // 2 horizons x 3 runs of selective + 2 greedy + 2 greedy-nocrit + 1 optimum.
     assert_eq!(records(&dir.join("m4")).len(), 2 * 3 + 2 + 2 + 1);
+}
+
+#[test]
+fn sweep_writes_summary_and_report_by_default() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 400);
+    let args: Vec<String> = sweep_args(&mesh, "rep", 3, "1..2")
+        .into_iter()
+        .filter(|a| a != "--no-report")
+        .collect();
+    let out = sweep(dir, &args, &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for f in [
+        "runs.jsonl",
+        "manifest.json",
+        "summary.csv",
+        "summary.json",
+        "report.md",
+    ] {
+        assert!(dir.join("rep").join(f).exists(), "{f} missing");
+    }
+    let csv = std::fs::read_to_string(dir.join("rep/summary.csv")).unwrap();
+    assert!(csv.contains("small,selective,2,quality_pct,3,"), "{csv}");
+    assert!(csv.contains("small,optimum,,quality_pct,1,100,"), "{csv}");
 }
 
 #[test]
