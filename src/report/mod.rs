@@ -665,10 +665,15 @@ fn method_notes(doc: &mut Document) {
         format!(
             "Differences between two sets of runs: two-sided Mann–Whitney U test (exact \
              distribution when the smaller sample has at most {} runs and there are no ties, \
-             otherwise the normal approximation with tie and continuity corrections); p-values \
-             of one family (one question, one measure) corrected with Holm's step-down method; \
-             significant means Holm p < {}.",
+             otherwise the normal approximation with tie and continuity corrections). Against a \
+             configuration run once (a deterministic baseline such as greedy with one baseline \
+             run), one value is not a sample to rank against: the other side is tested against \
+             that value with the two-sided Wilcoxon signed-rank test (T+; exact for at most {} \
+             differences without ties or zeros, otherwise normal with tie and continuity \
+             corrections). p-values of one family (one question, one measure) are corrected \
+             with Holm's step-down method; significant means Holm p < {}.",
             crate::stats::compare::EXACT_MAX_SIZE,
+            crate::stats::compare::EXACT_MAX_SIGNED_RANK,
             significance::ALPHA
         ),
         "Effect size: Vargha–Delaney A = P(first > second) + P(equal)/2; |A - 0.5| of at least \
