@@ -102,6 +102,7 @@ fn mann_whitney_nine_against_nine_without_ties_uses_normal() {
 }
 
 #[test]
+#[allow(clippy::approx_constant)] // 3.14 is data, not pi.
 fn signed_rank_matches_scipy() {
     // scipy 1.17.1 `wilcoxon(d)` reports min(T+, T-); p two-sided.
     // Exact (n = 9, no ties): differences of the nine pairs above; wilcoxon(x - y,
