@@ -16,6 +16,14 @@ if ! python3 -c "import gmsh" >/dev/null 2>&1; then
   python3 -m pip install -q gmsh==4.15.2 || echo "warning: could not install gmsh; its round-trip tests will skip"
 fi
 
+# GPU tests run on lavapipe: point the Vulkan loader at it when several drivers are installed
+# (set VK_DRIVER_FILES yourself to test another driver). The tests log the adapter they use.
+lvp=$(ls /usr/share/vulkan/icd.d/lvp_icd*.json 2>/dev/null | head -n 1 || true)
+if [ -z "${VK_DRIVER_FILES:-}" ] && [ -n "$lvp" ] && [ "$(ls /usr/share/vulkan/icd.d/*.json | wc -l)" -gt 1 ]; then
+  export VK_DRIVER_FILES="$lvp"
+fi
+echo "== Vulkan drivers for the GPU tests: ${VK_DRIVER_FILES:-loader default}"
+
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy"

@@ -3,8 +3,7 @@
 
 use super::BadInput;
 use quadrecomb::mesh::generate::{self, GridSpec, MAX_SUBDIVISIONS};
-use quadrecomb::mesh::{Mesh, ReadError};
-use std::io::Write;
+use quadrecomb::mesh::{Recombined, msh};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -104,7 +103,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let generated = start.elapsed().as_secs_f64();
     let start = Instant::now();
-    write_msh(&output, &mesh)?;
+    msh::write(&output, &mesh, &Recombined::unrecombined(&mesh))?;
     let written = start.elapsed().as_secs_f64();
     println!(
         "wrote {}: {} triangles, {} vertices ({what}); generated in {generated:.3} s, written in {written:.3} s",
@@ -135,81 +134,4 @@ fn check_output(path: &Path) -> Result<(), BadInput> {
         )));
     }
     Ok(())
-}
-
-/// Writes a plain triangle mesh as MSH 4.1 ASCII: one surface entity per surface tag, all
-/// nodes in the first one's block, one triangle block per surface.
-///
-/// A stand-in until the io module's `quadrecomb::mesh::msh::write(path, mesh,
-/// &Recombined::unrecombined(mesh))` is merged, which should replace this body.
-fn write_msh(path: &Path, mesh: &Mesh) -> Result<(), ReadError> {
-    let io = |source| ReadError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = std::fs::File::create(path).map_err(io)?;
-    let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
-    write_msh_to(&mut w, mesh).map_err(io)?;
-    w.flush().map_err(io)
-}
-
-fn write_msh_to(w: &mut impl Write, mesh: &Mesh) -> std::io::Result<()> {
-    let surfaces = mesh.surfaces();
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in &mesh.vertices {
-        for d in 0..3 {
-            lo[d] = lo[d].min(p[d]);
-            hi[d] = hi[d].max(p[d]);
-        }
-    }
-    writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?;
-    writeln!(w, "$Entities\n0 0 {} 0", surfaces.len())?;
-    for s in &surfaces {
-        writeln!(
-            w,
-            "{s} {:?} {:?} {:?} {:?} {:?} {:?} 0 0",
-            lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]
-        )?;
-    }
-    writeln!(w, "$EndEntities")?;
-
-    let ids = &mesh.vertex_ids;
-    let nv = ids.len();
-    let (min, max) = (ids.iter().min(), ids.iter().max());
-    writeln!(
-        w,
-        "$Nodes\n1 {nv} {} {}",
-        min.unwrap_or(&0),
-        max.unwrap_or(&0)
-    )?;
-    writeln!(w, "2 {} 0 {nv}", surfaces[0])?;
-    for id in ids {
-        writeln!(w, "{id}")?;
-    }
-    for p in &mesh.vertices {
-        writeln!(w, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
-    }
-    writeln!(w, "$EndNodes")?;
-
-    let tids = &mesh.triangle_ids;
-    let (min, max) = (tids.iter().min(), tids.iter().max());
-    writeln!(
-        w,
-        "$Elements\n{} {} {} {}",
-        surfaces.len(),
-        tids.len(),
-        min.unwrap_or(&0),
-        max.unwrap_or(&0)
-    )?;
-    for &s in &surfaces {
-        let block: Vec<usize> = (0..mesh.num_triangles())
-            .filter(|&t| mesh.triangle_surface[t] == s)
-            .collect();
-        writeln!(w, "2 {s} 2 {}", block.len())?;
-        for t in block {
-            let [a, b, c] = mesh.triangles[t].map(|v| ids[v as usize]);
-            writeln!(w, "{} {a} {b} {c}", tids[t])?;
-        }
-    }
-    writeln!(w, "$EndElements")
 }

@@ -1,10 +1,44 @@
-//! `quadrecomb merge`.
+//! `quadrecomb merge`: combine the results directories of a sweep's shards.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-#[derive(Debug, clap::Args)]
-pub struct Args {}
+use anyhow::Context;
+use quadrecomb::experiment::merge::merge;
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`quadrecomb merge` is not implemented yet")
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Results directories of the shards (`sweep --shard I/N --out DIR`).
+    #[arg(required = true, value_name = "DIR")]
+    dirs: Vec<PathBuf>,
+    /// Directory to write the merged results into (must not hold runs yet).
+    #[arg(long)]
+    out: PathBuf,
+    /// Do not write the report of the merged results.
+    #[arg(long)]
+    no_report: bool,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let merged = merge(&args.dirs, &args.out).map_err(super::sweep::bad_input)?;
+    eprintln!(
+        "merge: {} runs from {} directories into {}",
+        merged.records,
+        merged.parts,
+        args.out.display()
+    );
+    if !args.no_report {
+        let out = &args.out;
+        let paths = quadrecomb::report::write(out, &quadrecomb::report::ReportOptions::default())
+            .with_context(|| {
+            format!(
+                "the merged results are complete in {}, but writing their report failed \
+                     (retry with `quadrecomb report {}`)",
+                out.display(),
+                out.display()
+            )
+        })?;
+        eprintln!("merge: report in {}", paths.markdown.display());
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -1,10 +1,214 @@
-//! `quadrecomb sweep`.
+//! `quadrecomb sweep`: the paper's horizon sweep (or any other) into a results directory.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::Context;
+use quadrecomb::experiment::ExperimentError;
+use quadrecomb::experiment::manifest::Shard;
+use quadrecomb::experiment::progress::ProgressMode;
+use quadrecomb::experiment::sweep::{self, DEFAULT_SEED, SweepConfig};
+use quadrecomb::gpu::Backend;
+
+use super::BadInput;
+
+/// Exit code after Ctrl-C (128 + SIGINT, as shells report it).
+const EXIT_INTERRUPTED: u8 = 130;
 
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Meshes (built-in names or files); default: borouchaki.
+    #[arg(long = "mesh", value_name = "MESH", num_args = 1..)]
+    meshes: Vec<String>,
+    /// Algorithms: selective, uniform, greedy, greedy-nocrit, optimum;
+    /// default: selective greedy greedy-nocrit optimum.
+    #[arg(long = "algo", value_name = "ALGO", num_args = 1..)]
+    algos: Vec<String>,
+    /// Horizons of selective and uniform: a range A..B (inclusive), a list 1,3,5, or one value.
+    #[arg(long, value_name = "H", default_value = "1..10", value_parser = parse_horizons)]
+    horizons: Horizons,
+    /// Runs per (mesh, selective/uniform, horizon).
+    #[arg(long, default_value_t = 128)]
+    runs: u32,
+    /// Runs per mesh of greedy and greedy-nocrit (deterministic: ties are broken by index).
+    #[arg(long, default_value_t = 1)]
+    baseline_runs: u32,
+    /// Worker threads (default: every core).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Base seed; every run's seed is derived from it and the run's identity.
+    #[arg(long, default_value_t = DEFAULT_SEED)]
+    seed: u64,
+    /// Who computes the quad qualities.
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
+    backend: Backend,
+    /// Results directory (default: results/<mesh> for one mesh, results/sweep otherwise;
+    /// with --shard I/N, results/<mesh>-shard-I-of-N).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Continue the sweep in --out, skipping the runs it already recorded.
+    #[arg(long)]
+    resume: bool,
+    /// Run only the I-th of N disjoint slices of the run list (1 <= I <= N).
+    #[arg(long, value_name = "I/N")]
+    shard: Option<Shard>,
+    /// Do not write the report at the end.
+    #[arg(long)]
+    no_report: bool,
+    /// Progress as plain lines even on a terminal.
+    #[arg(long, conflicts_with = "quiet")]
+    plain: bool,
+    /// No progress output.
+    #[arg(long, short)]
+    quiet: bool,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`quadrecomb sweep` is not implemented yet")
+#[derive(Debug, Clone)]
+struct Horizons(Vec<u32>);
+
+fn parse_horizons(s: &str) -> Result<Horizons, String> {
+    let num = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("bad horizon {t:?} in {s:?}: expected A..B, a,b,c or a number"))
+    };
+    let list = if let Some((a, b)) = s.split_once("..") {
+        let (a, b) = (num(a)?, num(b.trim_start_matches('='))?);
+        if a > b {
+            return Err(format!("empty horizon range {s:?}"));
+        }
+        (a..=b).collect()
+    } else {
+        s.split(',')
+            .map(num)
+            .collect::<Result<Vec<u32>, String>>()?
+    };
+    if list.contains(&0) {
+        return Err("horizons must be at least 1".into());
+    }
+    Ok(Horizons(list))
+}
+
+/// Set by Ctrl-C: the sweep stops handing out runs.
+static CANCEL: AtomicBool = AtomicBool::new(false);
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let paper = SweepConfig::paper();
+    let meshes = if args.meshes.is_empty() {
+        paper.meshes.clone()
+    } else {
+        args.meshes
+    };
+    let out = args.out.unwrap_or_else(|| {
+        let base = match meshes.as_slice() {
+            [one] => sweep::mesh_name(one),
+            _ => "sweep".to_string(),
+        };
+        // Shards get a directory each, so that they never share a run log.
+        let name = match args.shard {
+            Some(s) => format!("{base}-shard-{}-of-{}", s.index, s.count),
+            None => base,
+        };
+        PathBuf::from("results").join(name)
+    });
+    let config = SweepConfig {
+        meshes,
+        algos: if args.algos.is_empty() {
+            paper.algos.clone()
+        } else {
+            args.algos
+        },
+        horizons: args.horizons.0,
+        runs: args.runs,
+        baseline_runs: args.baseline_runs,
+        seed: args.seed,
+        threads: args.threads.unwrap_or(paper.threads),
+        backend: args.backend,
+        out: out.clone(),
+        resume: args.resume,
+        shard: args.shard,
+        progress: if args.quiet {
+            ProgressMode::Quiet
+        } else if args.plain {
+            ProgressMode::Plain
+        } else {
+            ProgressMode::Auto
+        },
+    };
+    config.validate().map_err(bad_input)?;
+
+    ctrlc::set_handler(|| {
+        if CANCEL.swap(true, Ordering::SeqCst) {
+            eprintln!("\nsweep: interrupted again, exiting now (finished runs are saved)");
+            std::process::exit(i32::from(EXIT_INTERRUPTED));
+        }
+        eprintln!("\nsweep: interrupted: finishing the runs in flight (Ctrl-C again to quit now)");
+    })
+    .context("installing the Ctrl-C handler")?;
+
+    let (manifest, report) = sweep::run(&config, &CANCEL).map_err(bad_input)?;
+    let shard = manifest
+        .shard
+        .map(|s| format!(" (shard {s})"))
+        .unwrap_or_default();
+    if report.cancelled {
+        eprintln!(
+            "sweep: interrupted: {} of {} runs recorded in {}{shard}; run the same command with --resume to finish",
+            report.already + report.done_now,
+            report.planned,
+            out.display()
+        );
+        return Ok(ExitCode::from(EXIT_INTERRUPTED));
+    }
+    eprintln!(
+        "sweep: {} runs done ({} new, {} already recorded) into {}{shard}; backend {}",
+        report.planned,
+        report.done_now,
+        report.already,
+        out.display(),
+        manifest.backend
+    );
+    if !args.no_report && manifest.shard.is_none() {
+        let paths = quadrecomb::report::write(&out, &quadrecomb::report::ReportOptions::default())
+            .with_context(|| {
+                format!(
+                    "the sweep's results are complete in {}, but writing its report failed \
+                     (retry with `quadrecomb report {}`)",
+                    out.display(),
+                    out.display()
+                )
+            })?;
+        eprintln!("sweep: report in {}", paths.markdown.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Marks errors caused by the user's input so that they exit with the bad-input code.
+pub(crate) fn bad_input(e: ExperimentError) -> anyhow::Error {
+    if e.is_bad_input() {
+        let msg = format!("{:#}", anyhow::Error::from(e));
+        anyhow::Error::new(BadInput(msg))
+    } else {
+        anyhow::Error::new(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn horizon_syntax() {
+        assert_eq!(
+            parse_horizons("1..10").unwrap().0,
+            (1..=10).collect::<Vec<_>>()
+        );
+        assert_eq!(parse_horizons("2..=4").unwrap().0, vec![2, 3, 4]);
+        assert_eq!(parse_horizons("1,3,5").unwrap().0, vec![1, 3, 5]);
+        assert_eq!(parse_horizons("7").unwrap().0, vec![7]);
+        assert!(parse_horizons("0..3").is_err());
+        assert!(parse_horizons("5..3").is_err());
+        assert!(parse_horizons("a").is_err());
+    }
 }

@@ -142,6 +142,7 @@ pub fn run(
 ) -> Result<EngineReport, ExperimentError> {
     let dir = &opts.dir;
     std::fs::create_dir_all(dir).map_err(|e| ExperimentError::io(dir, e))?;
+    let _lock = super::lock::DirLock::acquire(dir)?;
     let runs_path = dir.join(RUNS_FILE);
     let loaded = store::read(&runs_path)?;
     if dir.join(MANIFEST_FILE).exists() {

@@ -8,6 +8,7 @@
 
 pub mod engine;
 pub mod exec;
+pub mod lock;
 pub mod manifest;
 pub mod merge;
 pub mod plan;
@@ -16,7 +17,7 @@ pub mod record;
 pub mod seed;
 pub mod store;
 pub mod summary;
-//SWEEP
+pub mod sweep;
 
 pub use seed::{derive_seed, mesh_hash};
 
@@ -59,6 +60,16 @@ pub enum ExperimentError {
         /// Records found.
         records: usize,
     },
+    /// Another live process is writing the results directory.
+    #[error(
+        "{dir}: another sweep (process {pid}) is writing there; wait for it, stop it, or choose another --out"
+    )]
+    Busy {
+        /// The directory.
+        dir: PathBuf,
+        /// The process holding `DIR/.lock`.
+        pid: u32,
+    },
     /// Shards cannot be merged: missing, duplicated or foreign runs.
     #[error("merge: {0}")]
     Merge(String),
@@ -98,6 +109,7 @@ impl ExperimentError {
             ExperimentError::Corrupt { .. }
                 | ExperimentError::Mismatch { .. }
                 | ExperimentError::AlreadyExists { .. }
+                | ExperimentError::Busy { .. }
                 | ExperimentError::Merge(_)
                 | ExperimentError::Invalid(_)
                 | ExperimentError::Mesh { .. }

@@ -1,7 +1,11 @@
-//! Progress on stderr: an indicatif bar with ETA on a terminal, plain periodic lines otherwise
-//! (logs of cluster jobs and CI).
+//! Progress on stderr: an indicatif bar with ETA on a terminal, plain lines every few seconds
+//! otherwise (logs of cluster jobs and CI), printed by a ticker thread so that long runs still
+//! show the sweep is alive.
 
 use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -11,7 +15,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 pub enum ProgressMode {
     /// A bar when stderr is a terminal, else plain lines.
     Auto,
-    /// Plain lines every `PLAIN_PERIOD`.
+    /// Plain lines every [`PLAIN_PERIOD`].
     Plain,
     /// Nothing.
     Quiet,
@@ -20,21 +24,35 @@ pub enum ProgressMode {
 /// Time between two plain progress lines.
 pub const PLAIN_PERIOD: Duration = Duration::from_secs(5);
 
+#[derive(Debug)]
+struct Shared {
+    total: u64,
+    done: AtomicU64,
+    start: Instant,
+    stop: Mutex<bool>,
+    wake: Condvar,
+}
+
 /// A progress display for a known number of runs.
 #[derive(Debug)]
 pub struct Progress {
     bar: Option<ProgressBar>,
-    plain: bool,
-    total: u64,
-    done: u64,
-    start: Instant,
-    last_line: Instant,
+    shared: Arc<Shared>,
+    ticker: Option<JoinHandle<()>>,
+    finished: AtomicBool,
 }
 
 impl Progress {
-    /// Starts showing progress over `total` runs (`already` of a larger list were done before).
+    /// Starts showing progress over `total` runs.
     pub fn new(mode: ProgressMode, total: u64) -> Progress {
         let terminal = std::io::stderr().is_terminal();
+        let shared = Arc::new(Shared {
+            total,
+            done: AtomicU64::new(0),
+            start: Instant::now(),
+            stop: Mutex::new(false),
+            wake: Condvar::new(),
+        });
         let bar = (mode == ProgressMode::Auto && terminal).then(|| {
             let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
             bar.set_style(
@@ -44,57 +62,110 @@ impl Progress {
                 .expect("valid template"),
             );
             bar.set_prefix("sweep");
+            bar.enable_steady_tick(Duration::from_millis(500));
             bar
         });
         let plain = mode == ProgressMode::Plain || (mode == ProgressMode::Auto && !terminal);
-        let now = Instant::now();
+        let ticker = plain.then(|| {
+            let shared = Arc::clone(&shared);
+            std::thread::spawn(move || {
+                let mut stop = shared.stop.lock().unwrap_or_else(|p| p.into_inner());
+                loop {
+                    let (guard, _) = shared
+                        .wake
+                        .wait_timeout(stop, PLAIN_PERIOD)
+                        .unwrap_or_else(|p| p.into_inner());
+                    stop = guard;
+                    if *stop {
+                        break;
+                    }
+                    eprintln!("{}", line(&shared));
+                }
+            })
+        });
         Progress {
             bar,
-            plain,
-            total,
-            done: 0,
-            start: now,
-            last_line: now,
+            shared,
+            ticker,
+            finished: AtomicBool::new(false),
         }
     }
 
     /// One more run finished.
-    pub fn inc(&mut self) {
-        self.done += 1;
+    pub fn inc(&self) {
+        self.shared.done.fetch_add(1, Ordering::SeqCst);
         if let Some(bar) = &self.bar {
             bar.inc(1);
-        } else if self.plain && self.last_line.elapsed() >= PLAIN_PERIOD {
-            self.last_line = Instant::now();
-            eprintln!("{}", self.line());
         }
     }
 
-    /// A line such as "sweep: 340/1283 runs (26.5%), 12.3 s elapsed, ETA 34 s".
+    /// The current plain line, e.g. "sweep: 340/1283 runs (26.5%), 12.3 s elapsed, ETA 34 s".
     pub fn line(&self) -> String {
-        let elapsed = self.start.elapsed().as_secs_f64();
-        let pct = if self.total == 0 {
-            100.0
-        } else {
-            100.0 * self.done as f64 / self.total as f64
-        };
-        let eta = if self.done == 0 {
-            "unknown".to_string()
-        } else {
-            let left = elapsed / self.done as f64 * (self.total - self.done.min(self.total)) as f64;
-            format!("{left:.0} s")
-        };
-        format!(
-            "sweep: {}/{} runs ({pct:.1}%), {elapsed:.1} s elapsed, ETA {eta}",
-            self.done, self.total
-        )
+        line(&self.shared)
     }
 
     /// Stops the display; prints a last plain line when in plain mode.
     pub fn finish(&mut self) {
+        if self.finished.swap(true, Ordering::SeqCst) {
+            return;
+        }
         if let Some(bar) = self.bar.take() {
             bar.abandon();
-        } else if self.plain {
-            eprintln!("{}", self.line());
         }
+        if let Some(t) = self.ticker.take() {
+            *self.shared.stop.lock().unwrap_or_else(|p| p.into_inner()) = true;
+            self.shared.wake.notify_all();
+            let _ = t.join();
+            eprintln!("{}", line(&self.shared));
+        }
+    }
+}
+
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.finish();
+    }
+}
+
+fn line(s: &Shared) -> String {
+    let done = s.done.load(Ordering::SeqCst);
+    let elapsed = s.start.elapsed().as_secs_f64();
+    let pct = if s.total == 0 {
+        100.0
+    } else {
+        100.0 * done as f64 / s.total as f64
+    };
+    let eta = if done == 0 {
+        "unknown".to_string()
+    } else {
+        let left = elapsed / done as f64 * s.total.saturating_sub(done) as f64;
+        format!("{left:.0} s")
+    };
+    format!(
+        "sweep: {done}/{} runs ({pct:.1}%), {elapsed:.1} s elapsed, ETA {eta}",
+        s.total
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plain_line_counts_and_estimates() {
+        let p = Progress::new(ProgressMode::Quiet, 4);
+        assert!(
+            p.line().starts_with("sweep: 0/4 runs (0.0%)"),
+            "{}",
+            p.line()
+        );
+        assert!(p.line().ends_with("ETA unknown"));
+        p.inc();
+        assert!(
+            p.line().starts_with("sweep: 1/4 runs (25.0%)"),
+            "{}",
+            p.line()
+        );
+        assert!(p.line().contains("ETA "));
     }
 }

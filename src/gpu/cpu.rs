@@ -3,14 +3,11 @@
 //! adapter exists. Parallel over candidates with rayon (run it inside a one-thread pool for
 //! a serial figure).
 
-use super::layout::{Batch, Vertex};
+use super::layout::{Batch, LocalQuad, Vertex};
 use rayon::prelude::*;
 
 const PI: f32 = std::f32::consts::PI;
 const FRAC_PI_2: f32 = std::f32::consts::FRAC_PI_2;
-const FRAC_PI_6: f32 = std::f32::consts::FRAC_PI_6;
-const SQRT_3: f32 = 1.732_050_8;
-const TAN_PI_12: f32 = 0.267_949_2;
 
 type V3 = [f32; 3];
 
@@ -27,20 +24,17 @@ fn edge(a: &Vertex, b: &Vertex) -> V3 {
     }
 }
 
-/// atan(a) for a in [0, 1] (range reduction to |t| <= tan(pi/12), Taylor series to t^13).
+/// atan(a) for a in [0, 1]: the kernel's degree-15 odd minimax polynomial.
 #[inline]
 fn atan_unit(a: f32) -> f32 {
-    let (t, base) = if a > TAN_PI_12 {
-        ((a * SQRT_3 - 1.0) / (a + SQRT_3), FRAC_PI_6)
-    } else {
-        (a, 0.0)
-    };
-    let s = t * t;
-    let p = 1.0
-        + s * (-1.0 / 3.0
-            + s * (1.0 / 5.0
-                + s * (-1.0 / 7.0 + s * (1.0 / 9.0 + s * (-1.0 / 11.0 + s * (1.0 / 13.0))))));
-    base + t * p
+    let s = a * a;
+    let p = 0.999_999_34
+        + s * (-0.333_298_6
+            + s * (0.199_465_66
+                + s * (-0.139_086_29
+                    + s * (0.096_421_95
+                        + s * (-0.055_912_3 + s * (0.021_862_94 + s * -0.004_054_56))))));
+    a * p
 }
 
 /// atan2(y, x) for y >= 0, in [0, pi]; (0, 0) gives 0.
@@ -48,10 +42,8 @@ fn atan_unit(a: f32) -> f32 {
 fn atan2_pos(y: f32, x: f32) -> f32 {
     let ax = x.abs();
     let hi = y.max(ax);
-    if hi == 0.0 {
-        return 0.0;
-    }
-    let mut r = atan_unit(y.min(ax) / hi);
+    let t = if hi == 0.0 { 0.0 } else { y.min(ax) / hi };
+    let mut r = atan_unit(t);
     if y > ax {
         r = FRAC_PI_2 - r;
     }
@@ -79,11 +71,17 @@ fn neg(u: V3) -> V3 {
 
 /// The four interior angles of the quad `[s0, o1, s1, o0]` as the kernel computes them.
 pub fn quad_angles(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> [f32; 4] {
-    let a = edge(s0, s1);
-    let e0 = edge(s0, o0);
-    let e1 = edge(s0, o1);
-    let f0 = edge(s1, o0);
-    let f1 = edge(s1, o1);
+    angles_from_edges([
+        edge(s0, s1),
+        edge(s0, o0),
+        edge(s0, o1),
+        edge(s1, o0),
+        edge(s1, o1),
+    ])
+}
+
+/// The kernel's `eta_from_edges` angles from `[a, e0, e1, f0, f1]`.
+fn angles_from_edges([a, e0, e1, f0, f1]: [V3; 5]) -> [f32; 4] {
     [
         angle(a, e0) + angle(e1, a),
         angle(e1, f1),
@@ -94,7 +92,10 @@ pub fn quad_angles(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> [f32; 
 
 /// eta of the quad `[s0, o1, s1, o0]`, as the kernel's `quad_eta`.
 pub fn quad_eta(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> f32 {
-    let alpha = quad_angles(s0, o1, s1, o0);
+    eta_from_angles(quad_angles(s0, o1, s1, o0))
+}
+
+fn eta_from_angles(alpha: [f32; 4]) -> f32 {
     if alpha.iter().any(|&a| a <= 0.0 || a >= PI) {
         return 0.0;
     }
@@ -121,6 +122,20 @@ pub fn quad_quality(batch: &Batch) -> Vec<f32> {
             )
         })
         .collect()
+}
+
+/// The kernel's entry point `quad_quality_local` on the CPU (precomputed-edges layout).
+pub fn quad_quality_local(locals: &[LocalQuad]) -> Vec<f32> {
+    locals
+        .par_iter()
+        .with_min_len(4096)
+        .map(|l| eta_from_angles(angles_from_edges(l.edges())))
+        .collect()
+}
+
+/// CPU twin of `shaders/stream_copy.wgsl`.
+pub fn stream_copy(src: &[[f32; 4]], dst: &mut [[f32; 4]]) {
+    dst.par_iter_mut().zip(src).for_each(|(d, s)| *d = *s);
 }
 
 #[cfg(test)]

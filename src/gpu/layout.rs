@@ -16,8 +16,8 @@ pub struct Vertex {
 }
 
 /// Mirrors WGSL `struct Params` in `shaders/quad_quality.wgsl`: one dispatch's candidate
-/// count, invocations per row of the 2D dispatch grid, and the index subtracted from every
-/// vertex index (where a dispatch binds a window of the vertex buffer). 16 bytes.
+/// count, invocations per row of the 2D dispatch grid, the index subtracted from every
+/// vertex index, and the stride (in vec4) between the local layout's four planes. 16 bytes.
 #[allow(unsafe_code)] // the bytemuck derives expand to `unsafe impl`
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, bytemuck::Pod, bytemuck::Zeroable)]
@@ -25,8 +25,65 @@ pub struct Params {
     pub count: u32,
     pub row: u32,
     pub vertex_base: u32,
-    pub pad: u32,
+    pub plane: u32,
 }
+
+/// One candidate of the local layout, mirroring WGSL `locals` in `shaders/quad_quality.wgsl`
+/// (which holds `v[0..4]`, `v[4..8]`, `v[8..12]`, `v[12..16]` in four planes, see
+/// [`Batch::local_planes`]): the five edge vectors `a = s1 - s0, e0 = o0 - s0,
+/// e1 = o1 - s0, f0 = o0 - s1, f1 = o1 - s1`, computed in f64 and each scaled to a largest
+/// component of 1, packed as `[a.xyz e0.x] [e0.yz e1.xy] [e1.z f0.xyz] [f1.xyz 0]`.
+/// 64 bytes, read without gather.
+#[allow(unsafe_code)] // the bytemuck derives expand to `unsafe impl`
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LocalQuad {
+    pub v: [f32; 16],
+}
+
+impl LocalQuad {
+    /// The edges of the quad `[s0, o1, s1, o0]`.
+    pub fn new(p: [[f64; 3]; 4]) -> LocalQuad {
+        let [s0, o1, s1, o0] = p;
+        let edge = |a: [f64; 3], b: [f64; 3]| {
+            let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let m = d[0].abs().max(d[1].abs()).max(d[2].abs());
+            if m > 0.0 {
+                d.map(|x| (x / m) as f32)
+            } else {
+                [0.0; 3]
+            }
+        };
+        let (a, e0, e1, f0, f1) = (
+            edge(s0, s1),
+            edge(s0, o0),
+            edge(s0, o1),
+            edge(s1, o0),
+            edge(s1, o1),
+        );
+        LocalQuad {
+            v: [
+                a[0], a[1], a[2], e0[0], e0[1], e0[2], e1[0], e1[1], e1[2], f0[0], f0[1], f0[2],
+                f1[0], f1[1], f1[2], 0.0,
+            ],
+        }
+    }
+
+    /// The five edges `[a, e0, e1, f0, f1]`.
+    pub fn edges(&self) -> [[f32; 3]; 5] {
+        let v = &self.v;
+        [
+            [v[0], v[1], v[2]],
+            [v[3], v[4], v[5]],
+            [v[6], v[7], v[8]],
+            [v[9], v[10], v[11]],
+            [v[12], v[13], v[14]],
+        ]
+    }
+}
+
+/// Bytes of one [`LocalQuad`].
+pub const LOCAL_QUAD_BYTES: usize = std::mem::size_of::<LocalQuad>();
 
 /// Bytes the kernel reads per candidate (its four `u32` vertex indices) and writes (eta).
 pub const CANDIDATE_BYTES: usize = 16 + 4;
@@ -120,6 +177,36 @@ impl Batch {
     /// True when the batch has no candidate.
     pub fn is_empty(&self) -> bool {
         self.quads.is_empty()
+    }
+
+    /// The precomputed-edges layout of candidates `range` (from the normalised positions,
+    /// recombined to f64 from their hi + lo parts), in parallel.
+    pub fn local_quads(&self, range: Range<usize>) -> Vec<LocalQuad> {
+        use rayon::prelude::*;
+        let f64_of = |v: &Vertex| [0, 1, 2].map(|k| v.hi[k] as f64 + v.lo[k] as f64);
+        self.quads[range]
+            .par_iter()
+            .with_min_len(4096)
+            .map(|q| LocalQuad::new(q.map(|i| f64_of(&self.vertices[i as usize]))))
+            .collect()
+    }
+
+    /// The local layout of candidates `range` as the kernel reads it: four planes of
+    /// `range.len()` vec4 each (plane k holds `v[4k..4k + 4]` of every [`LocalQuad`]).
+    pub fn local_planes(&self, range: Range<usize>) -> Vec<[f32; 4]> {
+        use rayon::prelude::*;
+        let locals = self.local_quads(range);
+        let n = locals.len();
+        let mut planes = vec![[0.0f32; 4]; 4 * n];
+        planes
+            .par_chunks_mut(n.max(1))
+            .enumerate()
+            .for_each(|(k, plane)| {
+                for (dst, l) in plane.iter_mut().zip(&locals) {
+                    dst.copy_from_slice(&l.v[4 * k..4 * k + 4]);
+                }
+            });
+        planes
     }
 
     /// Bytes the kernel must move per candidate at least: indices read, eta written, and

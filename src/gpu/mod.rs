@@ -19,7 +19,8 @@ pub mod shader;
 pub mod synthetic;
 
 pub use device::{
-    Kernel, Timings, adapter_name, adapters, copy_bandwidth, evaluate, is_software, open_device,
+    Kernel, Layout, Timings, adapter_name, adapters, copy_bandwidth, evaluate, is_software,
+    open_device, stream_bandwidth,
 };
 pub use layout::Batch;
 
@@ -203,5 +204,33 @@ impl Evaluator {
                 .extend(eta[span.candidates.clone()].iter().map(|&e| e as f64));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn evaluator_can_be_shared_between_threads() {
+        fn shared<T: Send + Sync>() {}
+        shared::<Evaluator>();
+        shared::<Kernel>();
+    }
+
+    #[test]
+    fn cpu_twin_fills_empty_and_candidate_free_tables() {
+        let ev = Evaluator::cpu_twin();
+        ev.fill(&mut []).unwrap();
+        let mesh = Mesh::new(crate::mesh::MeshData {
+            vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            triangles: vec![[0, 1, 2]],
+            ..Default::default()
+        })
+        .unwrap();
+        let mut table = CandidateTable::topology_only(&mesh);
+        ev.fill(&mut [(&mesh, &mut table)]).unwrap();
+        assert!(table.eta.is_empty());
+        assert_eq!(Backend::default().to_string(), "auto");
     }
 }

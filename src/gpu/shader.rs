@@ -10,6 +10,13 @@ pub const QUAD_QUALITY_PATH: &str = "shaders/quad_quality.wgsl";
 pub const QUAD_QUALITY: &str = include_str!("../../shaders/quad_quality.wgsl");
 /// Entry point of the quality kernel (the CPU twin is `gpu::cpu::quad_quality`).
 pub const ENTRY_POINT: &str = "quad_quality";
+/// Entry point of the quality kernel on the precomputed-edges layout (CPU twin:
+/// `gpu::cpu::quad_quality_local`).
+pub const ENTRY_POINT_LOCAL: &str = "quad_quality_local";
+/// Path of the streaming-copy kernel (bandwidth measurement).
+pub const STREAM_COPY_PATH: &str = "shaders/stream_copy.wgsl";
+/// Source of the streaming-copy kernel; entry point `stream_copy`.
+pub const STREAM_COPY: &str = include_str!("../../shaders/stream_copy.wgsl");
 
 /// Parses and validates WGSL `source` with naga; errors carry the rendered spans.
 pub fn validate(source: &str, path: &str) -> Result<naga::Module, GpuError> {
@@ -37,6 +44,8 @@ mod tests {
     fn embedded_kernel_is_valid_and_has_its_entry_point() {
         let module = validate(QUAD_QUALITY, QUAD_QUALITY_PATH).unwrap();
         assert!(module.entry_points.iter().any(|e| e.name == ENTRY_POINT));
+        let module = validate(STREAM_COPY, STREAM_COPY_PATH).unwrap();
+        assert!(module.entry_points.iter().any(|e| e.name == "stream_copy"));
     }
 
     #[test]

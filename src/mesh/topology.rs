@@ -377,3 +377,130 @@ pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two triangles sharing the diagonal of the unit square, second one given with `order`.
+    fn square(second: [u32; 3]) -> MeshData {
+        MeshData {
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            triangles: vec![[0, 1, 2], second],
+            ..MeshData::default()
+        }
+    }
+
+    #[test]
+    fn square_has_one_dual_edge_and_four_boundary_edges() {
+        let mesh = Mesh::new(square([0, 2, 3])).unwrap();
+        mesh.sanity_check().unwrap();
+        assert_eq!(mesh.topology.num_dual_edges(), 1);
+        assert_eq!(mesh.topology.boundary_edges.len(), 4);
+        assert_eq!(mesh.topology.edges.len(), 5);
+        assert_eq!(mesh.topology.component_sizes, vec![2]);
+        assert_eq!(mesh.reoriented, 0);
+    }
+
+    #[test]
+    fn inconsistent_orientation_is_fixed() {
+        let mesh = Mesh::new(square([0, 3, 2])).unwrap();
+        mesh.sanity_check().unwrap();
+        assert_eq!(mesh.reoriented, 1);
+        assert_eq!(mesh.topology.num_dual_edges(), 1);
+    }
+
+    #[test]
+    fn different_surfaces_are_not_neighbours() {
+        let mut data = square([0, 2, 3]);
+        data.triangle_surface = vec![1, 2];
+        let mesh = Mesh::new(data).unwrap();
+        mesh.sanity_check().unwrap();
+        assert_eq!(mesh.topology.num_dual_edges(), 0);
+        assert_eq!(mesh.topology.component_sizes, vec![1, 1]);
+    }
+
+    #[test]
+    fn non_manifold_edge_is_an_error() {
+        let mut data = square([0, 2, 3]);
+        data.vertices.push([1.0, 1.0, 1.0]);
+        data.triangles.push([0, 2, 4]);
+        data.triangle_ids = vec![10, 11, 12];
+        let err = Mesh::new(data).unwrap_err();
+        assert!(
+            matches!(&err, MeshError::NonManifoldEdge { count: 3, elements, .. } if elements == &[10, 11, 12]),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn degenerate_and_duplicate_triangles_are_errors() {
+        let mut data = square([0, 2, 3]);
+        data.vertices[1] = [2.0, 2.0, 0.0]; // triangle 1 = (0,0), (2,2), (1,1): collinear
+        assert!(matches!(
+            Mesh::new(data).unwrap_err(),
+            MeshError::DegenerateTriangle { element: 1, .. }
+        ));
+        let mut data = square([0, 2, 3]);
+        data.triangles.push([2, 0, 1]);
+        assert!(matches!(
+            Mesh::new(data).unwrap_err(),
+            MeshError::DuplicateTriangle {
+                element: 3,
+                first: 1
+            }
+        ));
+    }
+
+    #[test]
+    fn moebius_strip_is_not_orientable() {
+        // A strip of 6 quads (12 triangles) whose ends are glued with a half twist.
+        let n = 6;
+        let mut vertices = Vec::new();
+        for i in 0..n {
+            let a = i as f64 / n as f64 * std::f64::consts::TAU;
+            let half = a / 2.0;
+            for s in [-0.3, 0.3] {
+                let r = 1.0 + s * half.cos();
+                vertices.push([r * a.cos(), r * a.sin(), s * half.sin()]);
+            }
+        }
+        let mut triangles = Vec::new();
+        for i in 0..n {
+            let (a, b) = (2 * i as u32, 2 * i as u32 + 1);
+            let (c, d) = if i + 1 < n {
+                (2 * (i + 1) as u32, 2 * (i + 1) as u32 + 1)
+            } else {
+                (1, 0) // the half twist
+            };
+            triangles.push([a, c, d]);
+            triangles.push([a, d, b]);
+        }
+        let err = Mesh::new(MeshData {
+            vertices,
+            triangles,
+            ..MeshData::default()
+        })
+        .unwrap_err();
+        assert!(matches!(err, MeshError::NonOrientable { .. }), "{err}");
+    }
+
+    #[test]
+    fn empty_and_triangle_free_meshes_are_errors() {
+        assert_eq!(
+            Mesh::new(MeshData::default()).unwrap_err(),
+            MeshError::Empty
+        );
+        let data = MeshData {
+            vertices: vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            quads: vec![[0, 1, 2, 3]],
+            ..MeshData::default()
+        };
+        assert_eq!(Mesh::new(data).unwrap_err(), MeshError::NoTriangles);
+    }
+}

@@ -43,14 +43,19 @@ impl Searcher<'_> {
     pub(super) fn greedy(&mut self) {
         loop {
             self.advance_cursor();
-            let next = self.order[self.cursor..]
-                .iter()
-                .copied()
-                .find(|&c| self.state.is_allowed(c));
-            match next {
-                Some(c) => self.state.apply(c),
-                None => break,
+            // Verdicts are rechecked lazily: only those greedy looks at.
+            let mut next = NONE;
+            for i in self.cursor..self.order.len() {
+                let c = self.order[i];
+                if self.state.is_allowed_lazy(c) {
+                    next = c;
+                    break;
+                }
             }
+            if next == NONE {
+                break;
+            }
+            self.state.apply_lazy(next);
         }
     }
 
@@ -69,7 +74,7 @@ impl Searcher<'_> {
             if first == NONE {
                 break;
             }
-            self.state.apply(first);
+            self.state.apply_lazy(first);
         }
     }
 
@@ -95,7 +100,7 @@ impl Searcher<'_> {
         while i < self.order.len() {
             let c = self.order[i];
             i += 1;
-            if !self.state.is_allowed(c) {
+            if !self.state.is_allowed_lazy(c) {
                 continue;
             }
             any = true;
@@ -115,7 +120,7 @@ impl Searcher<'_> {
                     *first = r;
                 }
             } else {
-                self.state.apply(c);
+                self.state.apply_lazy(c);
                 self.uniform_dfs(d + 1, h, partial + eta, top, r, best, first);
                 self.state.undo();
             }
@@ -158,7 +163,7 @@ impl Searcher<'_> {
         if d == h {
             return 0.0;
         }
-        self.state.apply(c);
+        self.state.apply_lazy(c);
         self.path.push(c);
         let v = self.selective_node(d, h);
         self.path.pop();
@@ -175,7 +180,7 @@ impl Searcher<'_> {
         self.nodes += 1;
         let mut best = f64::NEG_INFINITY;
         for c in table.by_triangle[t as usize] {
-            if c == NONE || !self.state.is_allowed(c) {
+            if c == NONE || !self.state.is_allowed_lazy(c) {
                 continue;
             }
             let v = table.eta[c as usize] + self.selective_child(c, d + 1, h);
@@ -196,7 +201,7 @@ impl Searcher<'_> {
                 if n == NONE {
                     continue;
                 }
-                let k = self.state.allowed_count(n);
+                let k = self.state.allowed_count_lazy(n);
                 if k == 0 || k > kmin {
                     continue;
                 }
@@ -213,6 +218,7 @@ impl Searcher<'_> {
             let i = self.pick(self.near.len());
             return Some(self.near[i]);
         }
+        self.state.resolve_all();
         let k = self.state.min_k()?;
         let n = self.state.bucket(k).len();
         let i = self.pick(n);

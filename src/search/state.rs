@@ -76,6 +76,12 @@ enum Op {
     Union { child: u32, root: u32 },
     /// A watch entry was pushed onto dead-component root `v`'s list.
     RootWatch(u32),
+    /// A candidate was marked stale (pushed on the dirty list).
+    Dirty,
+    /// Candidate `c` was rechecked and marked exact.
+    Clean(u32),
+    /// Candidate `c` was popped from the dirty list.
+    DirtyPop(u32),
 }
 
 /// Result of one criterion check, with the parts the search enumerated left in scratch.
@@ -122,6 +128,9 @@ pub struct State<'a> {
     narcs: usize,
     split: Vec<u32>,
     split_pos: Vec<u32>,
+    /// Verdicts marked possibly stale by an action and not yet rechecked.
+    dirty: Vec<bool>,
+    dirty_list: Vec<u32>,
     chosen: Vec<u32>,
     quality: Vec<f64>,
     log: Vec<Op>,
@@ -131,11 +140,12 @@ pub struct State<'a> {
     epoch: u32,
     queue: [Vec<u32>; 4],
     head: [usize; 4],
+    /// Seeds (the quad's neighbours) at the front of each search queue.
+    nseed: [usize; 4],
+    /// How much of each queue the verdict depends on (its certificate).
+    cert_len: [usize; 4],
     group: [u8; 4],
     nsearch: usize,
-    cand_stamp: Vec<u32>,
-    cand_epoch: u32,
-    recheck: Vec<u32>,
     changed: Vec<u32>,
     moved: Vec<u32>,
     /// Number of criterion checks that needed a search (statistics).
@@ -260,6 +270,8 @@ impl<'a> State<'a> {
             narcs: 0,
             split: Vec::new(),
             split_pos: vec![NONE; m],
+            dirty: vec![false; m],
+            dirty_list: Vec::new(),
             chosen: Vec::new(),
             quality: vec![0.0],
             log: Vec::new(),
@@ -268,11 +280,10 @@ impl<'a> State<'a> {
             epoch: 0,
             queue: Default::default(),
             head: [0; 4],
+            nseed: [0; 4],
+            cert_len: [0; 4],
             group: [0; 4],
             nsearch: 0,
-            cand_stamp: vec![0; m],
-            cand_epoch: 0,
-            recheck: Vec::new(),
             changed: Vec::new(),
             moved: Vec::new(),
             searches: 0,
@@ -510,6 +521,9 @@ impl<'a> State<'a> {
                 }
             }
         }
+        for s in 0..ns {
+            self.nseed[s] = self.queue[s].len();
+        }
         let nb = &self.mesh.topology.neighbours;
         fn gfind(g: &[u8; 4], mut s: u8) -> u8 {
             while g[s as usize] != s {
@@ -518,6 +532,8 @@ impl<'a> State<'a> {
             s
         }
         loop {
+            // The verdict can only change when a search runs dry or two groups meet.
+            let mut event = false;
             for s in 0..ns {
                 let h = self.head[s];
                 if h == self.queue[s].len() {
@@ -540,10 +556,17 @@ impl<'a> State<'a> {
                             let (a, b) = (gfind(&self.group, o), gfind(&self.group, s as u8));
                             if a != b {
                                 self.group[a as usize] = b;
+                                event = true;
                             }
                         }
                     }
                 }
+                if self.head[s] == self.queue[s].len() {
+                    event = true;
+                }
+            }
+            if !event {
+                continue;
             }
             // Groups and how many are still running.
             let mut groups = 0;
@@ -567,6 +590,9 @@ impl<'a> State<'a> {
             }
             if groups == 1 {
                 self.count_searched(ns);
+                for s in 0..ns {
+                    self.cert_len[s] = self.queue[s].len();
+                }
                 return Check {
                     allowed: true,
                     kind: KIND_MET,
@@ -591,6 +617,18 @@ impl<'a> State<'a> {
                 for s in 0..ns {
                     let g = gfind(&self.group, s as u8);
                     self.group[s] = g;
+                }
+                // Certificate: the finished parts whole; for the running part, the paths
+                // along which its searches met, or only its seeds when it is one search
+                // (every triangle of that part then hangs off those seeds).
+                for s in 0..ns {
+                    let g = self.group[s] as usize;
+                    let alone = (0..ns).filter(|&r| self.group[r] as usize == g).count() == 1;
+                    self.cert_len[s] = if !gdone[g] && alone {
+                        self.nseed[s]
+                    } else {
+                        self.queue[s].len()
+                    };
                 }
                 return Check {
                     allowed: odd <= 1,
@@ -669,7 +707,7 @@ impl<'a> State<'a> {
             }
         } else if r.kind != KIND_LOCAL {
             for s in 0..self.nsearch {
-                for i in 0..self.queue[s].len() {
+                for i in 0..self.cert_len[s] {
                     let t = self.queue[s][i];
                     self.watch[t as usize].push((c, ver));
                     self.log.push(Op::Watch(t));
@@ -728,12 +766,60 @@ impl<'a> State<'a> {
         self.allowed[ci] = false;
     }
 
+    /// Marks the verdict of `c` as possibly stale (logged).
     fn mark(&mut self, c: u32) {
         let ci = c as usize;
-        if self.cand_stamp[ci] != self.cand_epoch {
-            self.cand_stamp[ci] = self.cand_epoch;
-            self.recheck.push(c);
+        if !self.dirty[ci] {
+            self.dirty[ci] = true;
+            self.dirty_list.push(c);
+            self.log.push(Op::Dirty);
         }
+    }
+
+    /// Makes the verdict of `c` exact (rechecks it if it was marked stale).
+    #[inline]
+    pub(crate) fn resolve(&mut self, c: u32) {
+        if self.dirty[c as usize] {
+            self.resolve_slow(c);
+        }
+    }
+
+    fn resolve_slow(&mut self, c: u32) {
+        if self.is_live(c) {
+            self.recheck_one(c);
+        }
+        self.dirty[c as usize] = false;
+        self.log.push(Op::Clean(c));
+    }
+
+    /// Makes every verdict exact.
+    pub(crate) fn resolve_all(&mut self) {
+        while let Some(c) = self.dirty_list.pop() {
+            self.log.push(Op::DirtyPop(c));
+            if self.dirty[c as usize] {
+                self.resolve_slow(c);
+            }
+        }
+    }
+
+    /// Exact allowed-ness inside a lazy tree (rechecks `c` first if needed).
+    #[inline]
+    pub(crate) fn is_allowed_lazy(&mut self, c: u32) -> bool {
+        self.resolve(c);
+        self.allowed[c as usize]
+    }
+
+    /// Exact number of allowed actions of `t` inside a lazy tree.
+    #[inline]
+    pub(crate) fn allowed_count_lazy(&mut self, t: u32) -> u32 {
+        if self.alive[t as usize] {
+            for c in self.table.by_triangle[t as usize] {
+                if c != NONE {
+                    self.resolve(c);
+                }
+            }
+        }
+        self.count[t as usize] as u32
     }
 
     // ------------------------------------------------------------------------------------
@@ -742,6 +828,13 @@ impl<'a> State<'a> {
     /// Recombines the two triangles of candidate `c` (both must remain; the criterion is
     /// not required, and stays exact after a forbidden action too).
     pub fn apply(&mut self, c: u32) {
+        self.apply_lazy(c);
+        self.resolve_all();
+    }
+
+    /// Like [`State::apply`], but the verdicts the action may have changed are only marked;
+    /// the lazy queries (and `resolve_all`) recheck them when asked. For the trees.
+    pub(crate) fn apply_lazy(&mut self, c: u32) {
         let ci = c as usize;
         let [t0, t1] = self.table.pairs[ci];
         assert!(
@@ -835,12 +928,6 @@ impl<'a> State<'a> {
             }
         }
         // Vertices whose fan lost its first triangle: their links are gone.
-        self.cand_epoch = self.cand_epoch.wrapping_add(1);
-        if self.cand_epoch == 0 {
-            self.cand_stamp.iter_mut().for_each(|s| *s = 0);
-            self.cand_epoch = 1;
-        }
-        self.recheck.clear();
         self.moved.clear();
         for x in [t0, t1] {
             for v in self.mesh.triangles[x as usize] {
@@ -890,10 +977,6 @@ impl<'a> State<'a> {
                     }
                 }
             }
-        }
-        for i in 0..self.recheck.len() {
-            let c2 = self.recheck[i];
-            self.recheck_one(c2);
         }
     }
 
@@ -967,6 +1050,12 @@ impl<'a> State<'a> {
                 Op::RootWatch(v) => {
                     self.root_watch[v as usize].pop();
                 }
+                Op::Dirty => {
+                    let c = self.dirty_list.pop().expect("dirty entry");
+                    self.dirty[c as usize] = false;
+                }
+                Op::Clean(c) => self.dirty[c as usize] = true,
+                Op::DirtyPop(c) => self.dirty_list.push(c),
                 Op::SplitRem { c, pos } => {
                     let p = pos as usize;
                     if p == self.split.len() {
@@ -995,6 +1084,9 @@ impl<'a> State<'a> {
     /// verdicts against a from-scratch evaluation of the criterion. O(n) per candidate:
     /// for tests only.
     pub fn sanity_check(&self) -> Result<(), String> {
+        if let Some(c) = (0..self.dirty.len()).find(|&c| self.dirty[c]) {
+            return Err(format!("candidate {c} still marked stale"));
+        }
         let nt = self.alive.len();
         for t in 0..nt {
             let k = self.count[t];

@@ -1,6 +1,10 @@
 //! The one integration-test binary: each module tests one area through the library or the CLI.
 
+mod gpu;
+mod io;
 mod meshes;
+mod optimum;
 mod report;
+mod runner;
 mod search;
 mod util;

@@ -1,10 +1,284 @@
-//! `quadrecomb bench gpu`.
+//! `quadrecomb bench gpu`: candidates per second of the quality evaluation on the f64
+//! reference, the CPU twin (1 thread, all threads) and every Vulkan adapter (lavapipe, a real
+//! GPU), split into upload, kernel and readback, against the device's memory-bandwidth bound.
 
+use anyhow::Context;
+use quadrecomb::gpu::layout::LOCAL_QUAD_BYTES;
+use quadrecomb::gpu::{self, Batch, Kernel, Layout, Timings, synthetic};
 use std::process::ExitCode;
+use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Candidate counts to measure (about; a jittered grid of ~n/3 cells^2 is generated).
+    #[arg(long, value_delimiter = ',', value_parser = parse_count,
+          default_value = "1e4,1e5,1e6,1e7")]
+    sizes: Vec<usize>,
+    /// Timed repetitions per size and backend (the best is reported), after one warm-up.
+    #[arg(long, default_value_t = 3)]
+    repeat: usize,
+    /// Skip the 1-thread CPU rows (f64 reference and twin) above this many candidates.
+    #[arg(long, value_parser = parse_count, default_value = "1e7")]
+    serial_max: usize,
+    /// Skip the Vulkan adapters (CPU rows only).
+    #[arg(long)]
+    cpu_only: bool,
+    /// Seed of the jittered grid.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`quadrecomb bench gpu` is not implemented yet")
+fn parse_count(s: &str) -> Result<usize, String> {
+    let v: f64 = s.trim().parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if !(1.0..=1e10).contains(&v) {
+        return Err(format!("{s:?}: expected a count between 1 and 1e10"));
+    }
+    Ok(v.round() as usize)
+}
+
+/// One measured row.
+struct Row {
+    backend: String,
+    candidates: usize,
+    t: Timings,
+    total_s: f64,
+    max_diff_f64: Option<f64>,
+    bound_pct: Option<f64>,
+}
+
+fn best_of<T>(
+    repeat: usize,
+    mut f: impl FnMut() -> anyhow::Result<(T, Timings, f64)>,
+) -> anyhow::Result<(T, Timings, f64)> {
+    let mut best: Option<(T, Timings, f64)> = None;
+    for _ in 0..repeat.max(1) {
+        let r = f()?;
+        if best.as_ref().is_none_or(|b| r.2 < b.2) {
+            best = Some(r);
+        }
+    }
+    Ok(best.expect("at least one repetition"))
+}
+
+fn max_diff(eta: &[f32], reference: &[f64]) -> f64 {
+    eta.iter()
+        .zip(reference)
+        .map(|(&a, &b)| (a as f64 - b).abs())
+        .fold(0.0, f64::max)
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let threads = rayon::current_num_threads();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .context("building a 1-thread pool")?;
+
+    // Devices, opened once: (name, device, queue, kernel, bandwidth).
+    let mut devices = Vec::new();
+    if !args.cpu_only {
+        let adapters = gpu::adapters();
+        if adapters.is_empty() {
+            eprintln!("no Vulkan adapter found: CPU rows only");
+        }
+        for a in adapters {
+            let info = a.get_info();
+            let name = gpu::adapter_name(&info);
+            let opened = gpu::open_device(&a).and_then(|(d, q)| Ok((Kernel::new(&d)?, d, q)));
+            let (kernel, device, queue) = match opened {
+                Ok(x) => x,
+                Err(e) => {
+                    eprintln!("skipping {name}: {e}");
+                    continue;
+                }
+            };
+            let probe = if gpu::is_software(&info) {
+                64 << 20
+            } else {
+                1 << 30
+            };
+            let copy = gpu::copy_bandwidth(&device, &queue, probe)
+                .with_context(|| format!("measuring the copy bandwidth of {name}"))?;
+            let stream = gpu::stream_bandwidth(&device, &queue, probe)
+                .with_context(|| format!("measuring the stream bandwidth of {name}"))?;
+            let bw = copy.max(stream);
+            println!(
+                "device: {name} ({:?}, driver {} {}), bandwidth (read + write): buffer copy \
+                 {:.1} GB/s, compute stream copy {:.1} GB/s; kernel timing: {}",
+                info.device_type,
+                info.driver,
+                info.driver_info,
+                copy / 1e9,
+                stream / 1e9,
+                if kernel.has_timestamps() {
+                    "timestamp queries"
+                } else {
+                    "submit + wait"
+                }
+            );
+            let kernels = vec![
+                (kernel, "indexed", true, Layout::Indexed),
+                (
+                    Kernel::with_layout(&device, Layout::Local)?,
+                    "local edges",
+                    true,
+                    Layout::Local,
+                ),
+                (
+                    Kernel::memory_only(&device, Layout::Indexed)?,
+                    "indexed, memory accesses only, diagnostic",
+                    false,
+                    Layout::Indexed,
+                ),
+                (
+                    Kernel::memory_only(&device, Layout::Local)?,
+                    "local edges, memory accesses only, diagnostic",
+                    false,
+                    Layout::Local,
+                ),
+            ];
+            devices.push((name, device, queue, kernels, bw));
+        }
+    }
+    println!("host: {threads} threads for the CPU rows");
+
+    let mut rows = Vec::new();
+    for &size in &args.sizes {
+        let n = ((size as f64 / 3.0).sqrt().ceil() as usize).max(1);
+        let (vertices, quads) = synthetic::jittered_grid(n, 0.2, args.seed);
+        let t = Instant::now();
+        let mut batch = Batch::new();
+        batch.push(&vertices, &quads)?;
+        let prepare_s = t.elapsed().as_secs_f64();
+        let c = batch.len();
+        let bytes = batch.bytes_per_candidate();
+        println!(
+            "\n{c} candidates ({n}x{n} jittered grid, {} vertices): host batch preparation \
+             (f64 -> hi/lo f32, index offsets) {:.2} ms; at least {bytes:.1} bytes per candidate \
+             indexed, {} with local edges",
+            vertices.len(),
+            prepare_s * 1e3,
+            LOCAL_QUAD_BYTES + 4
+        );
+        let reference: Vec<f64> = {
+            use rayon::prelude::*;
+            quads
+                .par_iter()
+                .map(|q| quadrecomb::quality::quad_eta(q.map(|v| vertices[v as usize])))
+                .collect()
+        };
+
+        let cpu_row = |name: String, f: &dyn Fn() -> Vec<f32>| -> anyhow::Result<Row> {
+            let _ = f();
+            let (eta, t, total) = best_of(args.repeat, || {
+                let s = Instant::now();
+                let eta = f();
+                let e = s.elapsed().as_secs_f64();
+                Ok((
+                    eta,
+                    Timings {
+                        kernel_s: e,
+                        ..Timings::default()
+                    },
+                    e,
+                ))
+            })?;
+            Ok(Row {
+                backend: name,
+                candidates: c,
+                t,
+                total_s: total,
+                max_diff_f64: Some(max_diff(&eta, &reference)),
+                bound_pct: None,
+            })
+        };
+        if c <= args.serial_max {
+            // The f64 reference, serial: what `CandidateTable::build` costs.
+            let s = Instant::now();
+            let r64: Vec<f64> = quads
+                .iter()
+                .map(|q| quadrecomb::quality::quad_eta(q.map(|v| vertices[v as usize])))
+                .collect();
+            let e = s.elapsed().as_secs_f64();
+            assert_eq!(r64.len(), c);
+            rows.push(Row {
+                backend: "f64 reference, 1 thread".into(),
+                candidates: c,
+                t: Timings {
+                    kernel_s: e,
+                    ..Timings::default()
+                },
+                total_s: e,
+                max_diff_f64: Some(0.0),
+                bound_pct: None,
+            });
+            rows.push(cpu_row("cpu-twin, 1 thread".into(), &|| {
+                one.install(|| gpu::cpu::quad_quality(&batch))
+            })?);
+        }
+        rows.push(cpu_row(format!("cpu-twin, {threads} threads"), &|| {
+            gpu::cpu::quad_quality(&batch)
+        })?);
+
+        for (name, device, queue, kernels, bw) in &devices {
+            for (k, what, is_eta, layout) in kernels {
+                let label = format!("{name} [{what}]");
+                let bytes = match layout {
+                    Layout::Indexed => bytes,
+                    Layout::Local => (LOCAL_QUAD_BYTES + 4) as f64,
+                };
+                k.run(device, queue, &batch)?; // warm-up
+                let (eta, t, total) = best_of(args.repeat, || {
+                    let s = Instant::now();
+                    let (eta, t) = k.run(device, queue, &batch)?;
+                    Ok((eta, t, s.elapsed().as_secs_f64()))
+                })?;
+                let achieved = c as f64 * bytes / t.kernel_best_s();
+                rows.push(Row {
+                    backend: label,
+                    candidates: c,
+                    t,
+                    total_s: total,
+                    max_diff_f64: is_eta.then(|| max_diff(&eta, &reference)),
+                    bound_pct: Some(100.0 * achieved / bw),
+                });
+            }
+        }
+        print_rows(
+            &rows[rows.len() - rows.iter().rev().take_while(|r| r.candidates == c).count()..],
+        );
+    }
+    println!("\nAll sizes:");
+    print_rows(&rows);
+    println!(
+        "\nkernel = device timestamps where supported (else submit + wait); total = upload + \
+         kernel + readback on the host clock, batch preparation excluded; bound = kernel bytes \
+         per second (bytes per candidate above) / the better measured bandwidth."
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_rows(rows: &[Row]) {
+    println!(
+        "| backend | candidates | upload ms | kernel ms | readback ms | total ms | \
+         Mcand/s kernel | Mcand/s total | % of bandwidth bound | max abs diff vs f64 |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for r in rows {
+        let k = r.t.kernel_best_s();
+        println!(
+            "| {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} | {:.1} | {} | {} |",
+            r.backend,
+            r.candidates,
+            r.t.upload_s * 1e3,
+            k * 1e3,
+            r.t.readback_s * 1e3,
+            r.total_s * 1e3,
+            r.candidates as f64 / k / 1e6,
+            r.candidates as f64 / r.total_s / 1e6,
+            r.bound_pct.map_or("-".to_string(), |p| format!("{p:.0}%")),
+            r.max_diff_f64
+                .map_or("-".to_string(), |d| format!("{d:.1e}"))
+        );
+    }
 }

@@ -1,10 +1,172 @@
-//! `quadrecomb bench optimum`.
+//! `quadrecomb bench optimum`: time of the exact optimum on the built-in meshes and on
+//! generated jittered grids of growing size, with the fitted growth exponent and peak memory.
 
-use std::process::ExitCode;
+use quadrecomb::mesh::{Mesh, MeshData};
+use quadrecomb::quality::CandidateTable;
+use quadrecomb::search::optimum;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::process::{Command, ExitCode};
 
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Grid sizes in triangles (comma-separated; each is rounded to a grid of squares).
+    #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 30_000, 100_000, 300_000, 1_000_000])]
+    sizes: Vec<usize>,
+    /// Built-in meshes or mesh files to time as well (skipped with a note when not loadable).
+    #[arg(long, value_delimiter = ',', default_values_t = ["borouchaki".to_string(), "sphere".to_string()])]
+    meshes: Vec<String>,
+    /// Timed runs per mesh; the minimum is reported.
+    #[arg(long, default_value_t = 5)]
+    repeat: usize,
+    /// Skip the peak-memory measurement (one child process per grid size).
+    #[arg(long)]
+    no_rss: bool,
+    /// Internal: solve one grid of this many triangles and print the peak RSS in bytes.
+    #[arg(long, hide = true)]
+    rss_child: Option<usize>,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`quadrecomb bench optimum` is not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    if let Some(n) = args.rss_child {
+        let mesh = grid(n, 1);
+        let table = CandidateTable::build(&mesh);
+        let opt = optimum::solve(&mesh, &table);
+        std::hint::black_box(&opt);
+        println!("{} {}", mesh.num_triangles(), peak_rss().unwrap_or(0));
+        return Ok(ExitCode::SUCCESS);
+    }
+    println!(
+        "{:<22} {:>10} {:>9} {:>6} {:>14} {:>10} {:>12}",
+        "mesh", "triangles", "quads", "left", "quality", "time_ms", "rss_B/tri"
+    );
+    for spec in &args.meshes {
+        match quadrecomb::mesh::load(spec) {
+            Ok(mesh) => {
+                let (opt, t) = time(&mesh, args.repeat);
+                print_row(spec, &mesh, &opt, t, None);
+            }
+            Err(e) => println!("{spec:<22} (not loadable here: {e})"),
+        }
+    }
+    let mut points = Vec::new();
+    for &n in &args.sizes {
+        let mesh = grid(n, 1);
+        let repeat = if mesh.num_triangles() > 200_000 {
+            args.repeat.min(3)
+        } else {
+            args.repeat
+        };
+        let (opt, t) = time(&mesh, repeat);
+        let rss = if args.no_rss { None } else { child_rss(n) };
+        print_row(&format!("grid {n}"), &mesh, &opt, t, rss);
+        points.push((mesh.num_triangles() as f64, t));
+    }
+    if points.len() >= 2 {
+        println!(
+            "growth exponent (least-squares slope of log time vs log triangles, grids): {:.2}",
+            slope(&points)
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_row(name: &str, mesh: &Mesh, opt: &optimum::Optimum, t: f64, rss: Option<f64>) {
+    let rss = rss.map_or("-".to_string(), |r| format!("{r:.0}"));
+    println!(
+        "{:<22} {:>10} {:>9} {:>6} {:>14.4} {:>10.2} {:>12}",
+        name,
+        mesh.num_triangles(),
+        opt.quads,
+        opt.triangles_left,
+        opt.quality,
+        1e3 * t,
+        rss
+    );
+}
+
+/// Best time of `repeat` solves (table built once, outside the timing).
+fn time(mesh: &Mesh, repeat: usize) -> (optimum::Optimum, f64) {
+    let table = CandidateTable::build(mesh);
+    let mut best = optimum::solve(mesh, &table);
+    for _ in 1..repeat.max(1) {
+        let o = optimum::solve(mesh, &table);
+        if o.time_s < best.time_s {
+            best = o;
+        }
+    }
+    let t = best.time_s;
+    (best, t)
+}
+
+/// Peak RSS per triangle of a child process that builds and solves one grid.
+fn child_rss(n: usize) -> Option<f64> {
+    let exe = std::env::current_exe().ok()?;
+    let out = Command::new(exe)
+        .args(["bench", "optimum", "--rss-child", &n.to_string()])
+        .output()
+        .ok()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut it = text.split_whitespace();
+    let nt: f64 = it.next()?.parse().ok()?;
+    let bytes: f64 = it.next()?.parse().ok()?;
+    (bytes > 0.0).then_some(bytes / nt)
+}
+
+/// Peak resident set size of this process in bytes (`VmHWM`), where /proc exists.
+fn peak_rss() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Least-squares slope of `ln t` against `ln n`.
+fn slope(points: &[(f64, f64)]) -> f64 {
+    let xs: Vec<f64> = points.iter().map(|p| p.0.ln()).collect();
+    let ys: Vec<f64> = points.iter().map(|p| p.1.ln()).collect();
+    let k = xs.len() as f64;
+    let (mx, my) = (xs.iter().sum::<f64>() / k, ys.iter().sum::<f64>() / k);
+    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
+    sxy / sxx
+}
+
+/// A jittered square grid of about `n` triangles (each square split along a random
+/// diagonal), seeded, so that every run times the same mesh.
+pub fn grid(n: usize, seed: u64) -> Mesh {
+    let squares = (n / 2).max(1);
+    let nx = ((squares as f64).sqrt().round() as usize).max(1);
+    let ny = squares.div_ceil(nx);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut vertices = Vec::with_capacity((nx + 1) * (ny + 1));
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let interior = i > 0 && i < nx && j > 0 && j < ny;
+            let (dx, dy) = if interior {
+                (rng.random_range(-0.2..0.2), rng.random_range(-0.2..0.2))
+            } else {
+                (0.0, 0.0)
+            };
+            vertices.push([i as f64 + dx, j as f64 + dy, 0.0]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut triangles = Vec::with_capacity(2 * nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if rng.random_bool(0.5) {
+                triangles.extend([[a, b, c], [a, c, d]]);
+            } else {
+                triangles.extend([[a, b, d], [b, c, d]]);
+            }
+        }
+    }
+    Mesh::new(MeshData {
+        vertices,
+        triangles,
+        ..MeshData::default()
+    })
+    .expect("a jittered grid is a valid mesh")
 }

@@ -9,9 +9,9 @@
 //! Binary files must be little-endian (checked with the format's int `1` marker) with 8-byte
 //! `size_t`.
 //!
-//! Errors name the file and the line (ASCII, [`ReadError::Syntax`]) or the byte offset (inside
-//! binary data: [`ReadError::Io`] of kind `InvalidData` whose message starts with
-//! `byte offset N:`). Content errors found by [`Mesh::new`] come back as [`ReadError::Mesh`]
+//! Errors name the file and the line (ASCII files, [`ReadError::Syntax`]) or the byte offset
+//! (binary files past their header, where binary data make line numbers meaningless:
+//! [`ReadError::Io`] of kind `InvalidData` whose message starts with `byte offset N:`). Content errors found by [`Mesh::new`] come back as [`ReadError::Mesh`]
 //! with the file's node and element tags.
 
 mod read;

@@ -1,8 +1,9 @@
 //! The hand-written MSH parser: 2.2 and 4.1, ASCII and binary (native little-endian, checked
 //! with the int `1` marker). One pass over the bytes, no per-line allocation.
 //!
-//! ASCII errors carry the line ([`ReadError::Syntax`]); errors inside binary data carry the
-//! byte offset (as [`ReadError::Io`] of kind `InvalidData`, whose message names the offset).
+//! Errors in ASCII files carry the line ([`ReadError::Syntax`]); errors in binary files past
+//! their header carry the byte offset (as [`ReadError::Io`] of kind `InvalidData`, whose
+//! message names the offset).
 
 use super::{MshFile, MshVersion};
 use crate::mesh::{MeshData, ReadError};
@@ -150,8 +151,12 @@ impl<'a> Parser<'a> {
             .count()
     }
 
-    /// An error at text position `pos` (reported with its line).
+    /// An error at position `pos`: its line in an ASCII file, its byte offset in a binary one
+    /// (where binary data make line numbers meaningless).
     fn err(&self, pos: usize, message: impl Into<String>) -> ReadError {
+        if self.binary {
+            return self.err_bin(pos, message.into());
+        }
         ReadError::Syntax {
             path: self.path.to_path_buf(),
             line: self.line_of(pos),
@@ -537,21 +542,13 @@ fn check_finite(p: &Parser<'_>, at: usize, tag: u64, x: [f64; 3]) -> Res<()> {
         "node {tag} has a non-finite coordinate ({}, {}, {})",
         x[0], x[1], x[2]
     );
-    Err(if p.binary {
-        p.err_bin(at, msg)
-    } else {
-        p.err(at, msg)
-    })
+    Err(p.err(at, msg))
 }
 
 fn to_i32(p: &Parser<'_>, at: usize, v: i64, what: &str) -> Res<i32> {
     i32::try_from(v).map_err(|_| {
         let msg = format!("{what} {v} is out of range");
-        if p.binary {
-            p.err_bin(at, msg)
-        } else {
-            p.err(at, msg)
-        }
+        p.err(at, msg)
     })
 }
 
@@ -744,11 +741,7 @@ fn push_element(
     for (k, &n) in nodes.iter().enumerate() {
         idx[k] = map.get(n).ok_or_else(|| {
             let msg = format!("element {tag} refers to node {n}, which does not exist");
-            if p.binary {
-                p.err_bin(at, msg)
-            } else {
-                p.err(at, msg)
-            }
+            p.err(at, msg)
         })?;
     }
     if nodes.len() == 3 {
@@ -1000,4 +993,48 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
         seen += n as u64;
     }
     Ok(total)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integers_parse_exactly_or_not_at_all() {
+        assert_eq!(parse_u64(b"0"), Some(0));
+        assert_eq!(parse_u64(b"18446744073709551615"), Some(u64::MAX));
+        assert_eq!(parse_u64(b"18446744073709551616"), None);
+        assert_eq!(parse_u64(b"-1"), None);
+        assert_eq!(parse_u64(b"1.0"), None);
+        assert_eq!(parse_u64(b""), None);
+        assert_eq!(parse_i64(b"-9223372036854775808"), Some(i64::MIN));
+        assert_eq!(parse_i64(b"-9223372036854775809"), None);
+        assert_eq!(parse_i64(b"9223372036854775808"), None);
+        assert_eq!(parse_i64(b"+5"), Some(5));
+        assert_eq!(parse_i64(b"-"), None);
+    }
+
+    #[test]
+    fn node_map_is_dense_for_compact_tags_and_sparse_otherwise() {
+        let dense = NodeMap::new(&[3, 1, 2]).unwrap();
+        assert!(matches!(dense, NodeMap::Dense(_)));
+        assert_eq!(
+            (dense.get(1), dense.get(3), dense.get(0), dense.get(99)),
+            (Some(1), Some(0), None, None)
+        );
+        let sparse = NodeMap::new(&[u64::MAX, 5]).unwrap();
+        assert!(matches!(sparse, NodeMap::Sparse(_)));
+        assert_eq!(
+            (sparse.get(u64::MAX), sparse.get(5), sparse.get(6)),
+            (Some(0), Some(1), None)
+        );
+        assert_eq!(NodeMap::new(&[4, 7, 4]).err(), Some(4));
+        assert_eq!(NodeMap::new(&[u64::MAX, 9, u64::MAX]).err(), Some(u64::MAX));
+    }
+
+    #[test]
+    fn shown_tokens_are_short_and_printable() {
+        assert_eq!(show(b"ab\x01"), "ab\\x01");
+        assert!(show(&[b'x'; 100]).ends_with("..."));
+    }
 }

@@ -1,0 +1,332 @@
+//! The real sweep: loads the meshes, computes every candidate's eta once (one evaluator batch
+//! over all meshes), the optimum once per mesh (cached by mesh hash), and runs the searches
+//! through [`super::engine`] with one reusable [`Searcher`] per thread and mesh.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use super::ExperimentError;
+use super::engine::{self, EngineOptions, EngineReport};
+use super::exec::{Outcome, Worker, WorkerFactory};
+use super::manifest::{Machine, Manifest, MeshEntry, OptimumEntry, Shard, SweepSpec};
+use super::plan::{Job, has_horizon};
+use super::progress::ProgressMode;
+use super::record::ALGO_NAMES;
+use super::seed::{eta_hash, mesh_hash};
+use crate::gpu::{Backend, Evaluator};
+use crate::mesh::Mesh;
+use crate::quality::CandidateTable;
+use crate::search::{Algo, Searcher};
+
+/// Algorithms of the default sweep (the paper's experiment), in order.
+pub const DEFAULT_ALGOS: &[&str] = &["selective", "greedy", "greedy-nocrit", "optimum"];
+/// The default base seed.
+pub const DEFAULT_SEED: u64 = 2026;
+/// Directory of the optimum cache inside a results directory.
+pub const OPTIMUM_CACHE_DIR: &str = "optimum-cache";
+
+/// A validated sweep configuration (what `quadrecomb sweep` parses its arguments into).
+#[derive(Debug, Clone)]
+pub struct SweepConfig {
+    /// Meshes: built-in names or paths.
+    pub meshes: Vec<String>,
+    /// Algorithm names (see [`ALGO_NAMES`]).
+    pub algos: Vec<String>,
+    /// Horizons of `uniform` and `selective`.
+    pub horizons: Vec<u32>,
+    /// Runs per (mesh, tree algorithm, horizon).
+    pub runs: u32,
+    /// Runs of `greedy` and `greedy-nocrit` per mesh.
+    pub baseline_runs: u32,
+    /// Base seed.
+    pub seed: u64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Who computes eta.
+    pub backend: Backend,
+    /// Results directory.
+    pub out: PathBuf,
+    /// Continue the sweep in `out`.
+    pub resume: bool,
+    /// Run only this slice of the run list.
+    pub shard: Option<Shard>,
+    /// Progress display.
+    pub progress: ProgressMode,
+}
+
+impl SweepConfig {
+    /// The paper's experiment on `borouchaki` into `results/borouchaki`.
+    pub fn paper() -> SweepConfig {
+        SweepConfig {
+            meshes: vec!["borouchaki".into()],
+            algos: DEFAULT_ALGOS.iter().map(|s| s.to_string()).collect(),
+            horizons: (1..=10).collect(),
+            runs: 128,
+            baseline_runs: 1,
+            seed: DEFAULT_SEED,
+            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            backend: Backend::Auto,
+            out: PathBuf::from("results/borouchaki"),
+            resume: false,
+            shard: None,
+            progress: ProgressMode::Auto,
+        }
+    }
+
+    /// Checks the configuration before any work starts.
+    pub fn validate(&self) -> Result<(), ExperimentError> {
+        let bad = |m: String| Err(ExperimentError::Invalid(m));
+        if self.meshes.is_empty() {
+            return bad("no mesh given".into());
+        }
+        if self.algos.is_empty() {
+            return bad("no algorithm given".into());
+        }
+        for (i, a) in self.algos.iter().enumerate() {
+            if !ALGO_NAMES.contains(&a.as_str()) {
+                return bad(format!(
+                    "unknown algorithm {a:?} (expected one of {})",
+                    ALGO_NAMES.join(", ")
+                ));
+            }
+            if self.algos[..i].contains(a) {
+                return bad(format!("algorithm {a:?} given twice"));
+            }
+        }
+        if self.algos.iter().any(|a| has_horizon(a)) {
+            if self.horizons.is_empty() {
+                return bad("no horizon given".into());
+            }
+            if self.horizons.contains(&0) {
+                return bad("horizons must be at least 1".into());
+            }
+            if self.runs == 0 {
+                return bad("--runs must be at least 1".into());
+            }
+        }
+        for (i, h) in self.horizons.iter().enumerate() {
+            if self.horizons[..i].contains(h) {
+                return bad(format!("horizon {h} given twice"));
+            }
+        }
+        if self.threads == 0 {
+            return bad("--threads must be at least 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// Meshes with their eta filled, optima computed, and the manifest of the sweep.
+#[derive(Debug)]
+pub struct Prepared {
+    /// Meshes, in spec order.
+    pub meshes: Vec<Mesh>,
+    /// Candidate tables with eta, in spec order.
+    pub tables: Vec<CandidateTable>,
+    /// The manifest to write.
+    pub manifest: Manifest,
+}
+
+/// The name a mesh has in records: the built-in name, or the file stem.
+pub fn mesh_name(spec: &str) -> String {
+    if crate::mesh::builtin::NAMES.contains(&spec) {
+        return spec.to_string();
+    }
+    Path::new(spec)
+        .file_stem()
+        .map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Loads the meshes, fills eta in one evaluator batch, and finds (or computes and caches
+/// under `config.out`) the optimum of each mesh.
+pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
+    config.validate()?;
+    let mut meshes = Vec::new();
+    let mut entries: Vec<MeshEntry> = Vec::new();
+    for spec in &config.meshes {
+        let mesh = crate::mesh::load(spec).map_err(|source| ExperimentError::Mesh {
+            spec: spec.clone(),
+            source,
+        })?;
+        let entry = MeshEntry {
+            name: mesh_name(spec),
+            source: spec.clone(),
+            hash: mesh_hash(&mesh),
+            triangles: mesh.num_triangles(),
+        };
+        if let Some(other) = entries.iter().find(|e| e.name == entry.name) {
+            return Err(ExperimentError::Invalid(format!(
+                "two meshes are named {:?} ({} and {}): rename one file",
+                entry.name, other.source, entry.source
+            )));
+        }
+        if let Some(other) = entries.iter().find(|e| e.hash == entry.hash) {
+            return Err(ExperimentError::Invalid(format!(
+                "{} and {} are the same mesh",
+                other.source, entry.source
+            )));
+        }
+        entries.push(entry);
+        meshes.push(mesh);
+    }
+    let evaluator = Evaluator::new(config.backend)?;
+    let mut tables: Vec<CandidateTable> =
+        meshes.iter().map(CandidateTable::topology_only).collect();
+    {
+        let mut jobs: Vec<(&Mesh, &mut CandidateTable)> =
+            meshes.iter().zip(tables.iter_mut()).collect();
+        evaluator.fill(&mut jobs)?;
+    }
+    let mut optimum = Vec::new();
+    for ((mesh, table), entry) in meshes.iter().zip(&tables).zip(&entries) {
+        optimum.push(cached_optimum(&config.out, mesh, table, entry)?);
+    }
+    let manifest = Manifest {
+        version: super::VERSION.to_string(),
+        spec: SweepSpec {
+            meshes: entries,
+            algos: config.algos.clone(),
+            horizons: if config.algos.iter().any(|a| has_horizon(a)) {
+                config.horizons.clone()
+            } else {
+                Vec::new()
+            },
+            runs: config.runs,
+            baseline_runs: config.baseline_runs,
+            seed: config.seed,
+        },
+        backend: evaluator.name().to_string(),
+        backend_requested: config.backend.to_string(),
+        optimum,
+        shard: config.shard,
+        threads: config.threads,
+        machine: Machine::current(),
+        merged_from: Vec::new(),
+    };
+    Ok(Prepared {
+        meshes,
+        tables,
+        manifest,
+    })
+}
+
+/// The optimum of `mesh` with `table`'s eta: read from `out/optimum-cache/<mesh hash>.json`
+/// when it was computed from the same eta, else computed and written there.
+pub fn cached_optimum(
+    out: &Path,
+    mesh: &Mesh,
+    table: &CandidateTable,
+    entry: &MeshEntry,
+) -> Result<OptimumEntry, ExperimentError> {
+    let dir = out.join(OPTIMUM_CACHE_DIR);
+    let path = dir.join(format!("{}.json", entry.hash));
+    let eta = eta_hash(&table.eta);
+    if let Ok(text) = std::fs::read_to_string(&path) {
+        if let Ok(cached) = serde_json::from_str::<OptimumEntry>(&text) {
+            if cached.mesh_hash == entry.hash && cached.eta_hash == eta {
+                return Ok(OptimumEntry {
+                    mesh: entry.name.clone(),
+                    ..cached
+                });
+            }
+        }
+    }
+    let opt = crate::search::optimum::solve(mesh, table);
+    let found = OptimumEntry {
+        mesh: entry.name.clone(),
+        mesh_hash: entry.hash.clone(),
+        eta_hash: eta,
+        quality: opt.quality,
+        quads: opt.quads,
+        triangles_left: opt.triangles_left,
+        time_s: opt.time_s,
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| ExperimentError::io(&dir, e))?;
+    let text = serde_json::to_string_pretty(&found).expect("serializes");
+    super::write_atomic(&path, format!("{text}\n").as_bytes())?;
+    Ok(found)
+}
+
+/// Runs searches (and reports the precomputed optimum) for the engine.
+#[derive(Debug)]
+pub struct SearchFactory<'a> {
+    meshes: &'a [Mesh],
+    tables: &'a [CandidateTable],
+    optimum: &'a [OptimumEntry],
+}
+
+impl<'a> SearchFactory<'a> {
+    /// A factory over prepared meshes.
+    pub fn new(prepared: &'a Prepared) -> SearchFactory<'a> {
+        SearchFactory {
+            meshes: &prepared.meshes,
+            tables: &prepared.tables,
+            optimum: &prepared.manifest.optimum,
+        }
+    }
+}
+
+struct SearchWorker<'a> {
+    factory: &'a SearchFactory<'a>,
+    searchers: Vec<Option<Searcher<'a>>>,
+}
+
+impl WorkerFactory for SearchFactory<'_> {
+    fn worker(&self) -> Box<dyn Worker + '_> {
+        Box::new(SearchWorker {
+            factory: self,
+            searchers: (0..self.meshes.len()).map(|_| None).collect(),
+        })
+    }
+}
+
+impl Worker for SearchWorker<'_> {
+    fn run(&mut self, job: &Job) -> Result<Outcome, ExperimentError> {
+        if job.algo == "optimum" {
+            let o = &self.factory.optimum[job.mesh];
+            return Ok(Outcome {
+                quads: o.quads,
+                triangles_left: o.triangles_left,
+                quality: o.quality,
+                nodes_expanded: 0,
+                decisions: o.quads as u64,
+                time_s: o.time_s,
+            });
+        }
+        let algo = Algo::from_name(&job.algo, job.horizon.unwrap_or(1))
+            .map_err(|e| ExperimentError::Invalid(e.to_string()))?;
+        let f = self.factory;
+        let searcher = self.searchers[job.mesh]
+            .get_or_insert_with(|| Searcher::new(&f.meshes[job.mesh], &f.tables[job.mesh]));
+        let out = searcher.run(algo, job.seed);
+        Ok(Outcome {
+            quads: out.quads,
+            triangles_left: out.triangles_left,
+            quality: out.quality,
+            nodes_expanded: out.nodes_expanded,
+            decisions: out.decisions,
+            time_s: out.time_s,
+        })
+    }
+}
+
+/// Prepares and runs a sweep into `config.out`; `cancel` stops it between runs.
+pub fn run(
+    config: &SweepConfig,
+    cancel: &AtomicBool,
+) -> Result<(Manifest, EngineReport), ExperimentError> {
+    let prepared = prepare(config)?;
+    let factory = SearchFactory::new(&prepared);
+    let report = engine::run(
+        &prepared.manifest,
+        &factory,
+        &EngineOptions {
+            dir: config.out.clone(),
+            resume: config.resume,
+            threads: config.threads,
+            progress: config.progress,
+        },
+        cancel,
+    )?;
+    Ok((prepared.manifest.clone(), report))
+}

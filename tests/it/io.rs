@@ -1,0 +1,858 @@
+//! Mesh input and output: the four MSH variants, round trips through the writers (and Gmsh),
+//! every bad input through the CLI, and a seeded mutation fuzzer over the MSH reader.
+
+use crate::util::{SEED, repo_path, run_in};
+use quadrecomb::mesh::{self, Mesh, MeshError, ReadError, Recombined, msh, vtu};
+use quadrecomb::quality::{self, CandidateTable};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn data(name: &str) -> PathBuf {
+    repo_path("tests/data").join(name)
+}
+
+/// Coordinates equal up to the 16 significant digits Gmsh writes in ASCII files.
+fn assert_close(a: &[[f64; 3]], b: &[[f64; 3]], what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}");
+    for (p, q) in a.iter().zip(b) {
+        for k in 0..3 {
+            assert!(
+                (p[k] - q[k]).abs() <= 1e-15 * p[k].abs().max(1.0),
+                "{what}: {p:?} vs {q:?}"
+            );
+        }
+    }
+}
+
+fn read(name: &str) -> Mesh {
+    let m = msh::read(&data(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    m.sanity_check().unwrap_or_else(|e| panic!("{name}: {e}"));
+    m
+}
+
+/// Triangles as sets of node tags, with their element tag and surface.
+fn triangle_set(m: &Mesh) -> BTreeSet<([u64; 3], i32)> {
+    m.triangles
+        .iter()
+        .zip(&m.triangle_surface)
+        .map(|(t, &s)| {
+            let mut k = t.map(|v| m.vertex_ids[v as usize]);
+            k.sort_unstable();
+            (k, s)
+        })
+        .collect()
+}
+
+fn quad_set(m: &Mesh) -> BTreeSet<([u64; 4], i32)> {
+    m.quads
+        .iter()
+        .zip(&m.quad_surface)
+        .map(|(q, &s)| {
+            let mut k = q.map(|v| m.vertex_ids[v as usize]);
+            k.sort_unstable();
+            (k, s)
+        })
+        .collect()
+}
+
+/// Whether the `gmsh` Python module can be used; in CI (`CI` set) it must be.
+fn gmsh_available() -> bool {
+    let ok = Command::new("python3")
+        .args(["-c", "import gmsh"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok && std::env::var_os("CI").is_some() {
+        panic!("the gmsh Python module is required in CI (pip install gmsh==4.15.2)");
+    }
+    if !ok {
+        eprintln!("skipping: python3 -c 'import gmsh' failed");
+    }
+    ok
+}
+
+/// Element counts (triangles, quads) and node count of `path` as Gmsh reads them.
+fn gmsh_counts(path: &Path) -> (usize, usize, usize) {
+    let script = r#"
+import sys, gmsh
+gmsh.initialize(["-noenv"])
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.open(sys.argv[1])
+def count(t):
+    return sum(len(tags) for tags in [gmsh.model.mesh.getElementsByType(t)[0]])
+print(count(2), count(3), len(gmsh.model.mesh.getNodes()[0]))
+gmsh.finalize()
+"#;
+    let out = Command::new("python3")
+        .args(["-c", script])
+        .arg(path)
+        .output()
+        .expect("run python3");
+    assert!(
+        out.status.success(),
+        "gmsh could not open {}: {}",
+        path.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = String::from_utf8_lossy(&out.stdout);
+    let v: Vec<usize> = s.split_whitespace().map(|x| x.parse().unwrap()).collect();
+    (v[0], v[1], v[2])
+}
+
+/// A matching of candidates: take each candidate whose triangles are both still free.
+fn greedy(mesh: &Mesh, table: &CandidateTable) -> Vec<u32> {
+    let mut used = vec![false; mesh.num_triangles()];
+    let mut chosen = Vec::new();
+    for (c, &[a, b]) in table.pairs.iter().enumerate() {
+        if !used[a as usize] && !used[b as usize] {
+            used[a as usize] = true;
+            used[b as usize] = true;
+            chosen.push(c as u32);
+        }
+    }
+    chosen
+}
+
+#[test]
+fn four_variants_read_identically() {
+    let names = [
+        ("two_squares_22_ascii.msh", "2.2", false),
+        ("two_squares_22_bin.msh", "2.2", true),
+        ("two_squares_41_ascii.msh", "4.1", false),
+        ("two_squares_41_bin.msh", "4.1", true),
+    ];
+    let first = read(names[0].0);
+    assert_eq!(first.num_triangles(), 44);
+    assert_eq!(first.vertices.len(), 31);
+    assert_eq!(first.surfaces(), vec![1, 2]);
+    for (name, version, binary) in names {
+        let bytes = std::fs::read(data(name)).unwrap();
+        let file = msh::parse(Path::new(name), &bytes).unwrap();
+        assert_eq!(file.version.to_string(), version, "{name}");
+        assert_eq!(file.binary, binary, "{name}");
+        assert!(
+            file.ignored_elements > 0,
+            "{name}: points and lines are skipped"
+        );
+        let m = read(name);
+        assert_close(&m.vertices, &first.vertices, name);
+        assert_eq!(m.vertex_ids, first.vertex_ids, "{name}");
+        assert_eq!(m.triangles, first.triangles, "{name}");
+        assert_eq!(m.triangle_ids, first.triangle_ids, "{name}");
+        assert_eq!(m.triangle_surface, first.triangle_surface, "{name}");
+        // read_bytes gives the same mesh and names the file it was given.
+        let mb = msh::read_bytes(name, &bytes).unwrap();
+        assert_eq!(mb.triangles, m.triangles);
+    }
+}
+
+#[test]
+fn crlf_and_byte_order_mark_are_accepted() {
+    let text = std::fs::read_to_string(data("two_squares_41_ascii.msh")).unwrap();
+    let dos = format!("\u{feff}{}", text.replace('\n', "\r\n"));
+    let a = msh::read_bytes("dos.msh", dos.as_bytes()).unwrap();
+    let b = read("two_squares_41_ascii.msh");
+    assert_eq!(a.triangles, b.triangles);
+    assert_eq!(a.vertices, b.vertices);
+}
+
+#[test]
+fn triangle_counts_match_gmsh() {
+    if !gmsh_available() {
+        return;
+    }
+    for name in [
+        "two_squares_22_bin.msh",
+        "two_squares_41_ascii.msh",
+        "mixed_41_ascii.msh",
+        "param_41_bin.msh",
+    ] {
+        let m = read(name);
+        let (t, q, _) = gmsh_counts(&data(name));
+        assert_eq!((m.num_triangles(), m.quads.len()), (t, q), "{name}");
+    }
+}
+
+#[test]
+fn parametric_coordinates_are_skipped() {
+    let a = read("param_41_ascii.msh");
+    let b = read("param_41_bin.msh");
+    assert_eq!(a.num_triangles(), 26);
+    assert_close(&a.vertices, &b.vertices, "param");
+    assert_eq!(a.triangles, b.triangles);
+    for p in &a.vertices {
+        assert!((0.0..=1.0).contains(&p[0]) && (0.0..=1.0).contains(&p[1]) && p[2] == 0.0);
+    }
+}
+
+#[test]
+fn input_quads_are_kept() {
+    let a = read("mixed_41_ascii.msh");
+    let b = read("mixed_22_ascii.msh");
+    assert_eq!((a.num_triangles(), a.quads.len()), (22, 11));
+    assert_eq!(triangle_set(&a), triangle_set(&b));
+    assert_eq!(quad_set(&a), quad_set(&b));
+    // Quads are on their own surface and never part of a candidate.
+    assert!(a.quad_surface.iter().all(|&s| s == 2));
+    assert!(a.triangle_surface.iter().all(|&s| s == 1));
+}
+
+#[test]
+fn sparse_tags_are_mapped_and_reported() {
+    let text = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n\
+                1000000000000 0 0 0\n7 1 0 0\n123456789 1 1 0\n3 0 1 0\n$EndNodes\n\
+                $Elements\n2\n101 2 2 5 5 1000000000000 7 123456789\n\
+                205 2 2 5 5 1000000000000 123456789 3\n$EndElements\n";
+    let m = msh::read_bytes("sparse.msh", text.as_bytes()).unwrap();
+    m.sanity_check().unwrap();
+    assert_eq!(m.vertex_ids, vec![1_000_000_000_000, 7, 123_456_789, 3]);
+    assert_eq!(m.triangle_ids, vec![101, 205]);
+    assert_eq!(m.triangle_surface, vec![5, 5]);
+    // Content errors carry the file's tags, not indices.
+    let dup = text.replace("123456789 3\n", "7 123456789\n");
+    match msh::read_bytes("sparse.msh", dup.as_bytes()) {
+        Err(ReadError::Mesh {
+            source: MeshError::DuplicateTriangle { element, first },
+            ..
+        }) => assert_eq!((element, first), (205, 101)),
+        other => panic!("expected a duplicate triangle, got {other:?}"),
+    }
+}
+
+#[test]
+fn load_detects_format_by_content() {
+    let dir = tempfile::tempdir().unwrap();
+    // A MSH file with another extension loads; a non-MSH file with .msh does not.
+    let odd = dir.path().join("mesh.dat");
+    std::fs::copy(data("two_squares_41_bin.msh"), &odd).unwrap();
+    assert_eq!(
+        mesh::load(odd.to_str().unwrap()).unwrap().num_triangles(),
+        44
+    );
+    let bad = data("bad/unknown_format.msh");
+    assert!(matches!(
+        mesh::load(bad.to_str().unwrap()),
+        Err(ReadError::UnknownFormat { .. })
+    ));
+    let missing = dir.path().join("missing.msh");
+    match mesh::load(missing.to_str().unwrap()) {
+        Err(e @ ReadError::Io { .. }) => assert!(e.to_string().contains("missing.msh"), "{e}"),
+        other => panic!("expected an I/O error, got {other:?}"),
+    }
+    for &name in mesh::builtin::NAMES {
+        let m = mesh::load(name).unwrap_or_else(|e| panic!("built-in {name}: {e}"));
+        m.sanity_check().unwrap();
+        if name == "borouchaki" {
+            assert_eq!(m.num_triangles(), 34_456);
+        }
+    }
+}
+
+#[test]
+fn msh_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in [
+        "two_squares_41_ascii.msh",
+        "mixed_22_ascii.msh",
+        "param_41_bin.msh",
+    ] {
+        let m = read(name);
+        // Unrecombined: the same triangles and quads come back.
+        let out = dir.path().join("plain.msh");
+        msh::write(&out, &m, &Recombined::unrecombined(&m)).unwrap();
+        let back = msh::read(&out).unwrap();
+        back.sanity_check().unwrap();
+        assert_eq!(back.vertices.len(), m.vertices.len(), "{name}");
+        assert_eq!(triangle_set(&back), triangle_set(&m), "{name}");
+        assert_eq!(quad_set(&back), quad_set(&m), "{name}");
+        // Recombined: quads plus leftover triangles, on the right surfaces.
+        let table = CandidateTable::build(&m);
+        let chosen = greedy(&m, &table);
+        assert!(!chosen.is_empty());
+        let rec = quality::recombined(&m, &table, &chosen);
+        let out = dir.path().join("rec.msh");
+        msh::write(&out, &m, &rec).unwrap();
+        let back = msh::read(&out).unwrap();
+        back.sanity_check().unwrap();
+        assert_eq!(back.num_triangles(), rec.leftover.len(), "{name}");
+        assert_eq!(back.quads.len(), rec.quads.len() + m.quads.len(), "{name}");
+        assert_eq!(back.surfaces(), m.surfaces(), "{name}");
+        let mut want: Vec<i32> = rec.quad_surface.clone();
+        want.extend(&m.quad_surface);
+        want.sort_unstable();
+        let mut got = back.quad_surface.clone();
+        got.sort_unstable();
+        assert_eq!(got, want, "{name}");
+        // The same mesh through every reader variant: the written 4.1 file re-parses exactly.
+        let again = msh::read_bytes("rec.msh", &std::fs::read(&out).unwrap()).unwrap();
+        assert_eq!(again.vertices, back.vertices);
+    }
+}
+
+#[test]
+fn written_msh_opens_in_gmsh() {
+    if !gmsh_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["two_squares_41_ascii.msh", "mixed_41_ascii.msh"] {
+        let m = read(name);
+        let table = CandidateTable::build(&m);
+        let rec = quality::recombined(&m, &table, &greedy(&m, &table));
+        let out = dir.path().join("rec.msh");
+        msh::write(&out, &m, &rec).unwrap();
+        let (t, q, n) = gmsh_counts(&out);
+        assert_eq!(t, rec.leftover.len(), "{name}: triangles");
+        assert_eq!(q, rec.quads.len() + m.quads.len(), "{name}: quads");
+        assert_eq!(n, m.vertices.len(), "{name}: nodes");
+    }
+}
+
+/// The whitespace-separated values of the `<DataArray ... Name="name" ...>` element.
+fn data_array<'a>(xml: &'a str, name: &str) -> Vec<&'a str> {
+    let key = format!("Name=\"{name}\"");
+    let start = xml.find(&key).unwrap_or_else(|| panic!("no array {name}"));
+    let body = &xml[start..];
+    let open = body.find('>').unwrap() + 1;
+    let close = body.find("</DataArray>").unwrap();
+    body[open..close].split_whitespace().collect()
+}
+
+#[test]
+fn vtu_is_well_formed_with_cell_data() {
+    let m = read("mixed_41_ascii.msh");
+    let table = CandidateTable::build(&m);
+    let rec = quality::recombined(&m, &table, &greedy(&m, &table));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rec.vtu");
+    vtu::write(&out, &m, &rec).unwrap();
+    let xml = std::fs::read_to_string(&out).unwrap();
+    let cells = rec.quads.len() + m.quads.len() + rec.leftover.len();
+    assert!(xml.contains(&format!(
+        "NumberOfPoints=\"{}\" NumberOfCells=\"{cells}\"",
+        m.vertices.len()
+    )));
+    let types = data_array(&xml, "types");
+    assert_eq!(types.len(), cells);
+    assert_eq!(
+        types.iter().filter(|&&t| t == "9").count(),
+        rec.quads.len() + m.quads.len()
+    );
+    assert_eq!(
+        types.iter().filter(|&&t| t == "5").count(),
+        rec.leftover.len()
+    );
+    let offsets = data_array(&xml, "offsets");
+    let conn = data_array(&xml, "connectivity");
+    assert_eq!(
+        offsets.last().unwrap().parse::<usize>().unwrap(),
+        conn.len()
+    );
+    assert!(
+        conn.iter()
+            .all(|v| v.parse::<usize>().unwrap() < m.vertices.len())
+    );
+    let quality: Vec<f64> = data_array(&xml, "quality")
+        .iter()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let kind = data_array(&xml, "kind");
+    assert_eq!(quality.len(), cells);
+    assert_eq!(data_array(&xml, "surface").len(), cells);
+    for (q, k) in quality.iter().zip(&kind) {
+        match *k {
+            "0" => assert!((0.0..=1.0).contains(q)),
+            "1" | "2" => assert_eq!(*q, -1.0),
+            other => panic!("unknown kind {other}"),
+        }
+    }
+    let etas: Vec<f64> = quality.iter().copied().filter(|&q| q >= 0.0).collect();
+    assert_eq!(etas, rec.quad_eta);
+    // Well-formed XML, checked by Python's parser where Python is present.
+    if let Ok(o) = Command::new("python3")
+        .args([
+            "-c",
+            "import sys, xml.etree.ElementTree as E; E.parse(sys.argv[1])",
+        ])
+        .arg(&out)
+        .output()
+    {
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+}
+
+/// Runs `quadrecomb info path` and checks exit code 2, no panic, and that the message names
+/// the file and says each of `expect`.
+fn assert_bad(path: &Path, expect: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_in(dir.path(), &["info", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{}: {err}", path.display());
+    assert!(!err.contains("panicked"), "{err}");
+    let file = path.file_name().unwrap().to_str().unwrap();
+    assert!(err.contains(file), "message does not name {file}: {err}");
+    for e in expect {
+        assert!(err.contains(e), "message lacks `{e}`: {err}");
+    }
+    err
+}
+
+fn bad(name: &str) -> PathBuf {
+    data("bad").join(name)
+}
+
+#[test]
+fn bad_input_missing_file() {
+    assert_bad(
+        Path::new("/nonexistent/dir/no_such_mesh.msh"),
+        &["No such file"],
+    );
+}
+
+#[test]
+fn bad_input_unknown_format_and_version() {
+    assert_bad(&bad("unknown_format.msh"), &["unknown mesh format"]);
+    assert_bad(
+        &bad("unsupported_version.msh"),
+        &[":2:", "unsupported MSH version `3.0`"],
+    );
+}
+
+#[test]
+fn bad_input_truncated_and_missing_sections() {
+    assert_bad(
+        &bad("truncated.msh"),
+        &[":15:", "truncated", "$EndElements"],
+    );
+    assert_bad(
+        &bad("missing_end_nodes.msh"),
+        &[":10:", "expected $EndNodes"],
+    );
+}
+
+#[test]
+fn bad_input_wrong_counts() {
+    assert_bad(
+        &bad("wrong_node_count.msh"),
+        &[
+            ":10:",
+            "node 5 of 5",
+            "fewer entries than its header announces",
+        ],
+    );
+    assert_bad(
+        &bad("wrong_element_count.msh"),
+        &[":15:", "element 3 of 3", "fewer entries"],
+    );
+    // More elements than announced.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(bad("odd_triangles.msh")).unwrap();
+    let p = dir.path().join("too_many.msh");
+    std::fs::write(&p, text.replace("$Elements\n3\n", "$Elements\n2\n")).unwrap();
+    assert_bad(&p, &[":16:", "expected $EndElements after 2 elements"]);
+}
+
+#[test]
+fn bad_input_unknown_node() {
+    assert_bad(
+        &bad("unknown_node.msh"),
+        &[":14:", "element 2 refers to node 9, which does not exist"],
+    );
+}
+
+#[test]
+fn bad_input_non_finite_coordinates() {
+    assert_bad(&bad("nan_coordinate.msh"), &[":8:", "node 3", "non-finite"]);
+    assert_bad(&bad("inf_coordinate.msh"), &[":8:", "node 3", "inf"]);
+}
+
+#[test]
+fn bad_input_degenerate_duplicate_non_manifold() {
+    assert_bad(&bad("degenerate.msh"), &["triangle 3 is degenerate"]);
+    assert_bad(&bad("duplicate.msh"), &["triangle 3 duplicates triangle 2"]);
+    assert_bad(
+        &bad("non_manifold.msh"),
+        &["non-manifold edge between nodes 1 and 3", "shared by 3"],
+    );
+}
+
+#[test]
+fn bad_input_non_orientable() {
+    assert_bad(&bad("moebius.msh"), &["not orientable"]);
+}
+
+#[test]
+fn bad_input_empty_and_no_triangles() {
+    assert_bad(&bad("empty.msh"), &["empty"]);
+    assert_bad(&bad("no_triangles.msh"), &["no triangles"]);
+}
+
+#[test]
+fn inconsistent_orientation_is_fixed() {
+    let m = msh::read(&bad("inconsistent_orientation.msh")).unwrap();
+    assert_eq!(m.reoriented, 1);
+    m.sanity_check().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let p = bad("inconsistent_orientation.msh");
+    let out = run_in(dir.path(), &["info", "--json", p.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["reoriented_triangles"], 1);
+}
+
+#[test]
+fn odd_triangle_count_is_valid() {
+    let m = msh::read(&bad("odd_triangles.msh")).unwrap();
+    m.sanity_check().unwrap();
+    assert_eq!(m.num_triangles(), 3);
+    let dir = tempfile::tempdir().unwrap();
+    let p = bad("odd_triangles.msh");
+    let out = run_in(dir.path(), &["info", "--json", p.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["triangles"], 3);
+    assert_eq!(v["odd_components"], 1);
+}
+
+#[test]
+fn bad_binary_input_names_the_byte_offset() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["two_squares_41_bin.msh", "two_squares_22_bin.msh"] {
+        let bytes = std::fs::read(data(name)).unwrap();
+        // Cut inside the binary node data.
+        let nodes = bytes.windows(7).position(|w| w == b"$Nodes\n").unwrap();
+        let p = dir.path().join(format!("cut_{name}"));
+        std::fs::write(&p, &bytes[..nodes + 60]).unwrap();
+        assert_bad(&p, &["byte offset", "truncated inside $Nodes"]);
+        // A byte-swapped endianness marker.
+        let marker = bytes
+            .windows(4)
+            .position(|w| w == 1i32.to_le_bytes())
+            .unwrap();
+        let mut swapped = bytes.clone();
+        swapped[marker..marker + 4].copy_from_slice(&1i32.to_be_bytes());
+        let p = dir.path().join(format!("be_{name}"));
+        std::fs::write(&p, &swapped).unwrap();
+        assert_bad(&p, &["byte offset", "big-endian"]);
+    }
+}
+
+#[test]
+fn info_reports_counts_and_eta_statistics() {
+    let m = read("two_squares_41_ascii.msh");
+    let table = CandidateTable::build(&m);
+    let dir = tempfile::tempdir().unwrap();
+    let p = data("two_squares_41_ascii.msh");
+    let out = run_in(dir.path(), &["info", "--json", p.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["triangles"], 44);
+    assert_eq!(v["vertices"], 31);
+    assert_eq!(v["surfaces"], 2);
+    assert_eq!(v["components"], 2);
+    assert_eq!(v["format"], "msh 4.1 ascii");
+    assert_eq!(v["boundary_edges"], m.topology.boundary_edges.len());
+    assert_eq!(v["candidate_pairs"], table.len());
+    let hist: u64 = v["eta"]["histogram"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_u64().unwrap())
+        .sum();
+    assert_eq!(hist as usize, table.len());
+    let min = table.eta.iter().copied().fold(f64::INFINITY, f64::min);
+    assert_eq!(v["eta"]["min"].as_f64().unwrap(), min);
+    assert!(v["time_ms"]["parse"].as_f64().unwrap() >= 0.0);
+    let text = run_in(dir.path(), &["info", p.to_str().unwrap()]);
+    let s = String::from_utf8_lossy(&text.stdout);
+    assert!(s.contains("triangles:            44"), "{s}");
+    assert!(
+        s.contains(&format!("candidate pairs:      {}", table.len())),
+        "{s}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fuzzing: seeded random mutations of valid (and bad) MSH files; the reader must never panic,
+// and every mesh it accepts must pass `sanity_check` and give a candidate table.
+
+/// Replacement numbers that stress counts, tags and coordinates.
+const NUMBERS: &[&str] = &[
+    "0",
+    "-1",
+    "1",
+    "2",
+    "3",
+    "4",
+    "7",
+    "65535",
+    "2147483647",
+    "2147483648",
+    "4294967295",
+    "4294967296",
+    "18446744073709551615",
+    "18446744073709551616",
+    "9223372036854775808",
+    "-9223372036854775808",
+    "1e308",
+    "-1e308",
+    "1e-320",
+    "nan",
+    "inf",
+    "-0",
+    "0.5",
+    "$EndNodes",
+    "$Elements",
+];
+
+fn token_spans(b: &[u8]) -> Vec<(usize, usize)> {
+    let mut spans = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        while i < b.len() && b[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        let s = i;
+        while i < b.len() && !b[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        if i > s {
+            spans.push((s, i));
+        }
+    }
+    spans
+}
+
+fn mutate(rng: &mut ChaCha8Rng, input: &[u8]) -> Vec<u8> {
+    let mut b = input.to_vec();
+    let ops = rng.random_range(1..=4);
+    for _ in 0..ops {
+        if b.is_empty() {
+            b.push(b'$');
+        }
+        match rng.random_range(0..8) {
+            0 => {
+                // Flip a byte (or a bit).
+                let i = rng.random_range(0..b.len());
+                b[i] = if rng.random_bool(0.5) {
+                    rng.random()
+                } else {
+                    b[i] ^ (1 << rng.random_range(0..8))
+                };
+            }
+            1 => {
+                let n = rng.random_range(0..b.len());
+                b.truncate(n);
+            }
+            2 | 3 => {
+                // Replace a token by a stress number.
+                let spans = token_spans(&b);
+                if let Some(&(s, e)) = spans.get(rng.random_range(0..spans.len().max(1))) {
+                    let r = NUMBERS[rng.random_range(0..NUMBERS.len())].as_bytes();
+                    b.splice(s..e, r.iter().copied());
+                }
+            }
+            4 => {
+                // Swap two tokens.
+                let spans = token_spans(&b);
+                if spans.len() >= 2 {
+                    let (i, j) = (
+                        rng.random_range(0..spans.len()),
+                        rng.random_range(0..spans.len()),
+                    );
+                    let (lo, hi) = (spans[i.min(j)], spans[i.max(j)]);
+                    if lo != hi {
+                        let a = b[lo.0..lo.1].to_vec();
+                        let c = b[hi.0..hi.1].to_vec();
+                        b.splice(hi.0..hi.1, a);
+                        b.splice(lo.0..lo.1, c);
+                    }
+                }
+            }
+            5 => {
+                // Delete or duplicate a range of bytes.
+                let s = rng.random_range(0..b.len());
+                let e = (s + rng.random_range(1..64)).min(b.len());
+                if rng.random_bool(0.5) {
+                    b.drain(s..e);
+                } else {
+                    let piece = b[s..e].to_vec();
+                    b.splice(e..e, piece);
+                }
+            }
+            6 => {
+                // Overwrite 8 bytes with an extreme binary value (counts, tags in binary files).
+                let s = rng.random_range(0..b.len());
+                let v: [u8; 8] = match rng.random_range(0..4) {
+                    0 => u64::MAX.to_le_bytes(),
+                    1 => (1u64 << 40).to_le_bytes(),
+                    2 => f64::NAN.to_le_bytes(),
+                    _ => rng.random(),
+                };
+                for (k, x) in v.iter().enumerate() {
+                    if let Some(y) = b.get_mut(s + k) {
+                        *y = *x;
+                    }
+                }
+            }
+            _ => {
+                // Insert random bytes.
+                let s = rng.random_range(0..=b.len());
+                let n = rng.random_range(1..16);
+                let ins: Vec<u8> = (0..n).map(|_| rng.random()).collect();
+                b.splice(s..s, ins);
+            }
+        }
+    }
+    b
+}
+
+/// Reads `bytes`; accepted meshes must be sane and give a candidate table. True if accepted.
+fn check_no_panic(bytes: &[u8]) -> bool {
+    let read = msh::read_bytes("fuzz.msh", bytes);
+    if let Ok(m) = &read {
+        m.sanity_check().expect("an accepted mesh is sane");
+        let table = CandidateTable::build(m);
+        assert!(table.eta.iter().all(|e| (0.0..=1.0).contains(e)));
+        let mut out = Vec::new();
+        msh::write_to(&mut out, m, &Recombined::unrecombined(m)).unwrap();
+        let back = msh::read_bytes("fuzz-written.msh", &out).expect("written mesh reads back");
+        assert_eq!(back.num_triangles(), m.num_triangles());
+    }
+    read.is_ok()
+}
+
+fn corpus() -> Vec<(String, Vec<u8>)> {
+    let mut files = Vec::new();
+    for dir in ["tests/data", "tests/data/bad"] {
+        let mut names: Vec<_> = std::fs::read_dir(repo_path(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "msh"))
+            .collect();
+        names.sort();
+        for p in names {
+            files.push((p.display().to_string(), std::fs::read(&p).unwrap()));
+        }
+    }
+    files
+}
+
+/// Runs `iters` mutations; returns the inputs that panicked (saved under `save` if given) and
+/// the number of mutants the reader accepted.
+fn fuzz(iters: u64, seed: u64, save: Option<&Path>) -> (Vec<Vec<u8>>, u64) {
+    let mut accepted = 0;
+    let corpus = corpus();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut crashes = Vec::new();
+    for i in 0..iters {
+        let (_, input) = &corpus[rng.random_range(0..corpus.len())];
+        let m = mutate(&mut rng, input);
+        let r = std::panic::catch_unwind(|| check_no_panic(&m));
+        accepted += u64::from(matches!(r, Ok(true)));
+        if r.is_err() {
+            if let Some(dir) = save {
+                std::fs::create_dir_all(dir).unwrap();
+                std::fs::write(dir.join(format!("crash-{seed:x}-{i}.msh")), &m).unwrap();
+            }
+            crashes.push(m);
+        }
+    }
+    (crashes, accepted)
+}
+
+#[test]
+fn fuzz_msh_reader_never_panics() {
+    let (crashes, accepted) = fuzz(3000, SEED, None);
+    assert!(
+        crashes.is_empty(),
+        "{} inputs panicked (seed {SEED:#x})",
+        crashes.len()
+    );
+    assert!(
+        accepted > 0,
+        "no mutant was a valid mesh: the fuzzer only tests errors"
+    );
+}
+
+/// The longer campaign: `QUADRECOMB_FUZZ_ITERS=2000000 cargo test --release --test it
+/// fuzz_campaign -- --ignored --nocapture`; panicking inputs go to `target/fuzz-crashes/`.
+#[test]
+#[ignore]
+fn fuzz_campaign() {
+    let iters = std::env::var("QUADRECOMB_FUZZ_ITERS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(200_000);
+    let seed = std::env::var("QUADRECOMB_FUZZ_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(SEED);
+    let save = repo_path("target/fuzz-crashes");
+    let t = std::time::Instant::now();
+    let (crashes, accepted) = fuzz(iters, seed, Some(&save));
+    eprintln!(
+        "fuzz campaign: {iters} inputs, seed {seed:#x}, {:.1} s, {accepted} accepted, {} panicked",
+        t.elapsed().as_secs_f64(),
+        crashes.len()
+    );
+    assert!(
+        crashes.is_empty(),
+        "panicking inputs saved in {}",
+        save.display()
+    );
+}
+
+/// Inputs frozen from fuzzing (tests/data/fuzz/): each must be read without a panic.
+#[test]
+fn fuzz_regressions() {
+    let dir = repo_path("tests/data/fuzz");
+    let mut n = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|e| e == "msh") {
+            check_no_panic(&std::fs::read(&p).unwrap());
+            n += 1;
+        }
+    }
+    assert!(n > 0, "no regression inputs in {}", dir.display());
+}
+
+#[test]
+fn bench_io_reports_each_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = data("two_squares_41_bin.msh");
+    let b = data("mixed_22_ascii.msh");
+    let out = run_in(
+        dir.path(),
+        &[
+            "bench",
+            "io",
+            "--reps",
+            "3",
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+        ],
+    );
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{s}");
+    let rows: Vec<&str> = s.lines().filter(|l| l.contains(".msh")).collect();
+    assert_eq!(rows.len(), 2, "{s}");
+    assert!(
+        rows[0].contains("msh 4.1 binary") && rows[0].contains(" 44 "),
+        "{s}"
+    );
+    assert!(
+        rows[1].contains("msh 2.2 ascii") && rows[1].contains(" 22 "),
+        "{s}"
+    );
+    let bad = run_in(
+        dir.path(),
+        &["bench", "io", "--reps", "0", a.to_str().unwrap()],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    let missing = run_in(dir.path(), &["bench", "io", "no_such.msh"]);
+    assert_eq!(missing.status.code(), Some(2));
+}

@@ -1,0 +1,432 @@
+//! The experiment runner end to end through the CLI: thread-count and shard invariance,
+//! kill -9 and Ctrl-C then --resume, torn lines, merge checks, statistics.
+
+use crate::util::{SEED, bin, run_in};
+use quadrecomb::experiment::record::RunRecord;
+use quadrecomb::experiment::store;
+use quadrecomb::stats::describe::{BoxStats, quantile, sd};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// A small generated mesh with an odd component, written into `dir`.
+fn small_mesh(dir: &Path, triangles: usize) -> PathBuf {
+    let out = run_in(
+        dir,
+        &[
+            "generate",
+            "grid",
+            "--triangles",
+            &triangles.to_string(),
+            "--seed",
+            &SEED.to_string(),
+            "--drop-triangles",
+            "1",
+            "-o",
+            "small.msh",
+        ],
+    );
+    assert!(out.status.success(), "generate: {}", stderr(&out));
+    dir.join("small.msh")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Arguments of a quick sweep on `mesh` into `out`.
+fn sweep_args(mesh: &Path, out: &str, runs: u32, horizons: &str) -> Vec<String> {
+    [
+        "sweep",
+        "--mesh",
+        mesh.to_str().unwrap(),
+        "--horizons",
+        horizons,
+        "--runs",
+        &runs.to_string(),
+        "--baseline-runs",
+        "2",
+        "--seed",
+        &SEED.to_string(),
+        "--backend",
+        "cpu",
+        "--no-report",
+        "--quiet",
+        "--out",
+        out,
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect()
+}
+
+fn sweep(dir: &Path, args: &[String], extra: &[&str]) -> Output {
+    let mut all: Vec<&str> = args.iter().map(String::as_str).collect();
+    all.extend_from_slice(extra);
+    run_in(dir, &all)
+}
+
+fn records(dir: &Path) -> Vec<RunRecord> {
+    let mut r = store::read(&dir.join("runs.jsonl")).unwrap().records;
+    r.sort_by_key(|r| r.key());
+    r
+}
+
+/// Same runs with the same results (every field but the wall-clock time).
+fn assert_same(a: &[RunRecord], b: &[RunRecord], what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: record counts differ");
+    for (x, y) in a.iter().zip(b) {
+        assert!(x.same_result(y), "{what}: {x:?}\n  vs\n{y:?}");
+    }
+}
+
+#[test]
+fn threads_and_merged_shards_give_identical_records() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    let one = sweep(
+        dir,
+        &sweep_args(&mesh, "t1", 5, "1..4"),
+        &["--threads", "1"],
+    );
+    assert!(one.status.success(), "{}", stderr(&one));
+    let two = sweep(
+        dir,
+        &sweep_args(&mesh, "t2", 5, "1..4"),
+        &["--threads", "2"],
+    );
+    assert!(two.status.success(), "{}", stderr(&two));
+    for i in 1..=3 {
+        let shard = format!("{i}/3");
+        let out = sweep(
+            dir,
+            &sweep_args(&mesh, &format!("s{i}"), 5, "1..4"),
+            &["--shard", &shard, "--threads", "2"],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let merged = run_in(
+        dir,
+        &["merge", "s1", "s2", "s3", "--out", "merged", "--no-report"],
+    );
+    assert!(merged.status.success(), "{}", stderr(&merged));
+
+    let a = records(&dir.join("t1"));
+    // 4 horizons x 5 runs of selective + 2 greedy + 2 greedy-nocrit + 1 optimum.
+    assert_eq!(a.len(), 4 * 5 + 2 + 2 + 1);
+    assert_same(&a, &records(&dir.join("t2")), "1 vs 2 threads");
+    assert_same(
+        &a,
+        &records(&dir.join("merged")),
+        "1 thread vs 3 merged shards",
+    );
+    // Shards are disjoint and none is empty.
+    let sizes: Vec<usize> = (1..=3)
+        .map(|i| records(&dir.join(format!("s{i}"))).len())
+        .collect();
+    assert_eq!(sizes.iter().sum::<usize>(), a.len());
+    assert!(sizes.iter().all(|&s| s > 0));
+
+    // The records are real runs: the optimum bounds every run, seeds differ between runs.
+    let opt = a.iter().find(|r| r.algo == "optimum").unwrap();
+    assert!((opt.quality_pct.unwrap() - 100.0).abs() < 1e-9);
+    for r in &a {
+        assert!(r.quality <= opt.quality + 1e-9, "{r:?}");
+        assert_eq!(r.quads * 2 + r.triangles_left, r.triangles);
+        assert_eq!(r.backend, "cpu-twin");
+    }
+    let sel: Vec<&RunRecord> = a.iter().filter(|r| r.algo == "selective").collect();
+    assert!(sel.iter().all(|r| r.nodes_expanded > 0));
+    assert!(
+        sel.iter()
+            .all(|r| r.branching_factor.is_some() == (r.horizon > Some(1)))
+    );
+    let seeds: std::collections::BTreeSet<u64> = a.iter().map(|r| r.seed).collect();
+    assert_eq!(seeds.len(), a.len());
+    for f in ["manifest.json", "summary.csv", "summary.json"] {
+        assert!(dir.join("merged").join(f).exists(), "{f}");
+    }
+}
+
+/// Waits until `path` holds at least `lines` complete lines (or `limit` passes).
+fn wait_for_lines(path: &Path, lines: usize, limit: Duration) -> usize {
+    let start = Instant::now();
+    loop {
+        let n = std::fs::read(path)
+            .map(|b| b.iter().filter(|&&c| c == b'\n').count())
+            .unwrap_or(0);
+        if n >= lines || start.elapsed() > limit {
+            return n;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+#[test]
+fn kill_9_then_resume_equals_an_uninterrupted_sweep() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    let args = sweep_args(&mesh, "killed", 40, "1..4");
+    let total = 4 * 40 + 2 + 2 + 1;
+    let mut child = Command::new(bin())
+        .args(&args)
+        .args(["--threads", "2"])
+        .current_dir(dir)
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let runs = dir.join("killed/runs.jsonl");
+    let seen = wait_for_lines(&runs, 20, Duration::from_secs(60));
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    let after_kill = store::read(&runs).unwrap();
+    assert!(seen >= 20, "only {seen} runs recorded before the kill");
+    assert!(
+        after_kill.records.len() < total,
+        "the sweep finished before it was killed: make it longer"
+    );
+    let resumed = sweep(dir, &args, &["--resume", "--threads", "2"]);
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
+
+    let full = sweep(
+        dir,
+        &sweep_args(&mesh, "full", 40, "1..4"),
+        &["--threads", "2"],
+    );
+    assert!(full.status.success(), "{}", stderr(&full));
+    let a = records(&dir.join("full"));
+    assert_eq!(a.len(), total);
+    assert_same(
+        &a,
+        &records(&dir.join("killed")),
+        "killed + resumed vs uninterrupted",
+    );
+    // Every line is complete and parses: no torn or duplicated line survived.
+    let text = std::fs::read_to_string(&runs).unwrap();
+    assert_eq!(text.lines().count(), total);
+    assert!(text.ends_with('\n'));
+}
+
+#[test]
+fn torn_last_line_is_redone_on_resume_and_fresh_sweep_refuses_a_used_dir() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    let args = sweep_args(&mesh, "out", 4, "1..3");
+    assert!(sweep(dir, &args, &[]).status.success());
+    let want = records(&dir.join("out"));
+    let runs = dir.join("out/runs.jsonl");
+    let text = std::fs::read(&runs).unwrap();
+    // Drop the last 3 lines and tear the one before them.
+    let ends: Vec<usize> = text
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| **c == b'\n')
+        .map(|(i, _)| i)
+        .collect();
+    let cut = ends[ends.len() - 5] + 1 + 30;
+    std::fs::write(&runs, &text[..cut]).unwrap();
+    assert_eq!(store::read(&runs).unwrap().records.len(), want.len() - 4);
+
+    let again = sweep(dir, &args, &[]);
+    assert_eq!(again.status.code(), Some(2), "{}", stderr(&again));
+    assert!(stderr(&again).contains("--resume"), "{}", stderr(&again));
+
+    let resumed = sweep(dir, &args, &["--resume"]);
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
+    assert_same(
+        &want,
+        &records(&dir.join("out")),
+        "torn + resumed vs original",
+    );
+    assert_eq!(
+        std::fs::read_to_string(&runs).unwrap().lines().count(),
+        want.len()
+    );
+
+    // Resuming with another configuration is refused.
+    let other = sweep(dir, &sweep_args(&mesh, "out", 5, "1..3"), &["--resume"]);
+    assert_eq!(other.status.code(), Some(2));
+    assert!(stderr(&other).contains("runs 5 vs 4"), "{}", stderr(&other));
+}
+
+#[test]
+fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    let args = sweep_args(&mesh, "int", 40, "1..4");
+    let total = 4 * 40 + 2 + 2 + 1;
+    let child = Command::new(bin())
+        .args(&args)
+        .args(["--threads", "2"])
+        .current_dir(dir)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let runs = dir.join("int/runs.jsonl");
+    assert!(wait_for_lines(&runs, 10, Duration::from_secs(60)) >= 10);
+    // A second sweep into the same directory while the first runs is refused.
+    let second = sweep(dir, &args, &["--resume"]);
+    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert!(
+        stderr(&second).contains("another sweep"),
+        "{}",
+        stderr(&second)
+    );
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+    assert!(stderr(&out).contains("interrupted"), "{}", stderr(&out));
+    let kept = store::read(&runs).unwrap();
+    assert_eq!(kept.torn_bytes, 0, "a clean stop leaves no torn line");
+    assert!(kept.records.len() >= 10 && kept.records.len() < total);
+    let resumed = sweep(dir, &args, &["--resume", "--threads", "2"]);
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
+    assert_eq!(records(&dir.join("int")).len(), total);
+}
+
+#[test]
+fn a_second_sweep_into_a_busy_directory_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    // Long enough to still be running when the second one starts; killed at the end.
+    let args = sweep_args(&mesh, "busy", 5000, "1..4");
+    let mut first = Command::new(bin())
+        .args(&args)
+        .args(["--threads", "1"])
+        .current_dir(dir)
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let runs = dir.join("busy/runs.jsonl");
+    assert!(wait_for_lines(&runs, 2, Duration::from_secs(60)) >= 2);
+    let second = sweep(dir, &args, &["--resume"]);
+    let still_running = first.try_wait().unwrap().is_none();
+    first.kill().unwrap();
+    first.wait().unwrap();
+    assert!(
+        still_running,
+        "the first sweep ended too early for this test"
+    );
+    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert!(
+        stderr(&second).contains("another sweep"),
+        "{}",
+        stderr(&second)
+    );
+    // Once the writer is gone (killed, leaving a stale lock), the lock is taken over: what
+    // stops this resume is now its different shard, not the lock.
+    let resumed = sweep(
+        dir,
+        &sweep_args(&mesh, "busy", 5000, "1..4"),
+        &["--resume", "--shard", "1/1"],
+    );
+    assert_eq!(
+        resumed.status.code(),
+        Some(2),
+        "a shard of another list is refused"
+    );
+    assert!(
+        stderr(&resumed).contains("shard 1/1 vs the whole run list"),
+        "{}",
+        stderr(&resumed)
+    );
+}
+
+#[test]
+fn merge_rejects_foreign_missing_and_duplicated_parts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    for i in 1..=2 {
+        let shard = format!("{i}/2");
+        let out = sweep(
+            dir,
+            &sweep_args(&mesh, &format!("p{i}"), 3, "1..2"),
+            &["--shard", &shard],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let mut other = sweep_args(&mesh, "q2", 3, "1..2");
+    let seed_pos = other.iter().position(|a| a == "--seed").unwrap();
+    other[seed_pos + 1] = "1".into();
+    assert!(sweep(dir, &other, &["--shard", "2/2"]).status.success());
+
+    let foreign = run_in(dir, &["merge", "p1", "q2", "--out", "m1", "--no-report"]);
+    assert_eq!(foreign.status.code(), Some(2));
+    assert!(
+        stderr(&foreign).contains("not parts of the same sweep"),
+        "{}",
+        stderr(&foreign)
+    );
+    assert!(stderr(&foreign).contains("seed"), "{}", stderr(&foreign));
+
+    let missing = run_in(dir, &["merge", "p1", "--out", "m2", "--no-report"]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(stderr(&missing).contains("missing"), "{}", stderr(&missing));
+
+    let dup = run_in(
+        dir,
+        &["merge", "p1", "p2", "p2", "--out", "m3", "--no-report"],
+    );
+    assert_eq!(dup.status.code(), Some(2));
+    assert!(stderr(&dup).contains("is in both"), "{}", stderr(&dup));
+
+    // A successful merge writes the report of the merged results.
+    let ok = run_in(dir, &["merge", "p1", "p2", "--out", "m4"]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    assert!(dir.join("m4/report.md").exists());
+    // 2 horizons x 3 runs of selective + 2 greedy + 2 greedy-nocrit + 1 optimum.
+    assert_eq!(records(&dir.join("m4")).len(), 2 * 3 + 2 + 2 + 1);
+}
+
+#[test]
+fn sweep_writes_summary_and_report_by_default() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 400);
+    let args: Vec<String> = sweep_args(&mesh, "rep", 3, "1..2")
+        .into_iter()
+        .filter(|a| a != "--no-report")
+        .collect();
+    let out = sweep(dir, &args, &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for f in [
+        "runs.jsonl",
+        "manifest.json",
+        "summary.csv",
+        "summary.json",
+        "report.md",
+    ] {
+        assert!(dir.join("rep").join(f).exists(), "{f} missing");
+    }
+    let csv = std::fs::read_to_string(dir.join("rep/summary.csv")).unwrap();
+    assert!(csv.contains("small,selective,2,quality_pct,3,"), "{csv}");
+    assert!(csv.contains("small,optimum,,quality_pct,1,100,"), "{csv}");
+}
+
+#[test]
+fn statistics_match_textbook_values() {
+    // R: quantile(1:10, type = 7) -> 1.00 3.25 5.50 7.75 10.00
+    let xs: Vec<f64> = (1..=10).map(f64::from).collect();
+    assert_eq!(quantile(&xs, 0.25), 3.25);
+    assert_eq!(quantile(&xs, 0.75), 7.75);
+    // 2 4 4 4 5 5 7 9: sample variance 32 / 7.
+    let ys = [2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0];
+    assert!((sd(&ys) - (32.0f64 / 7.0).sqrt()).abs() < 1e-12);
+    // Tukey: 1..10 plus 30 -> Q1 3.5, Q3 8.5, upper fence 16, so 30 is an outlier.
+    let mut zs = xs.clone();
+    zs.push(30.0);
+    let b = BoxStats::of(&zs).unwrap();
+    assert_eq!((b.q1, b.median, b.q3), (3.5, 6.0, 8.5));
+    assert_eq!((b.whisker_low, b.whisker_high), (1.0, 10.0));
+    assert_eq!(b.outliers, vec![30.0]);
+}
