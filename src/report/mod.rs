@@ -205,7 +205,10 @@ fn overview(doc: &mut Document, results: &Results) {
     let labels: Vec<String> = results
         .groups
         .iter()
-        .map(|(c, r)| format!("{} {} ({} runs)", c.mesh, c.label(), r.len()))
+        .map(|(c, r)| {
+            let runs = if r.len() == 1 { "run" } else { "runs" };
+            format!("{} {} ({} {runs})", c.mesh, c.label(), r.len())
+        })
         .collect();
     doc.para(format!("Configurations: {}.", labels.join("; ")));
 }
@@ -392,9 +395,9 @@ fn paper_beside(doc: &mut Document, mesh: &str, configs: &[(&Config, &[Run])]) {
     doc.list(case.notes.iter().map(|n| format!("Paper: {n}")).collect());
 }
 
-/// A number of the paper as printed there (at most two decimals), or "–".
+/// A number of the paper as printed there, or "–".
 fn paper_number(v: Option<f64>) -> String {
-    v.map_or("–".into(), |v| format!("{}", (v * 100.0).round() / 100.0))
+    v.map_or("–".into(), |v| format!("{v}"))
 }
 
 /// Fig.-8-style box plots for each algorithm with horizons.
@@ -503,14 +506,15 @@ fn picture_choice<'a>(
         .collect();
     algos.dedup();
     for algo in algos {
-        let best = configs
-            .iter()
-            .filter(|(c, _)| c.algo == algo)
-            .max_by(|a, b| {
-                median(&Metric::Quality.values(a.1))
-                    .total_cmp(&median(&Metric::Quality.values(b.1)))
-            });
-        out.extend(best.copied());
+        // The best median quality; the smallest horizon among equals (the cheapest to re-run).
+        let mut best: Option<(&Config, &[Run], f64)> = None;
+        for (c, r) in configs.iter().filter(|(c, _)| c.algo == algo) {
+            let q = median(&Metric::Quality.values(r));
+            if best.is_none_or(|b| q > b.2) {
+                best = Some((c, r, q));
+            }
+        }
+        out.extend(best.map(|(c, r, _)| (c, r)));
     }
     out
 }

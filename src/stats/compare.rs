@@ -173,7 +173,8 @@ pub fn signed_rank(x: &[f64], c: f64) -> SignedRank {
         .zip(&ranks)
         .filter(|(v, _)| **v > 0.0)
         .map(|(_, r)| r)
-        .sum();
+        .sum::<f64>()
+        + 0.0; // An empty f64 sum is -0.0.
     let nf = n as f64;
     let total = nf * (nf + 1.0) / 2.0;
     let t_min = t_plus.min(total - t_plus);
