@@ -469,13 +469,16 @@ fn box_plots(
                     caption.push_str("; the paper reports 1.33 on its Borouchaki mesh.");
                 }
             }
-            let svg = boxplot_svg(&format!("{mesh}: {algo}"), name, &boxes, log_y, &extras)?;
-            let file = format!(
-                "{FIGURES_DIR}/{}-{}-{}.svg",
-                slug(mesh),
-                slug(algo),
-                metric.key()
-            );
+            let stem = format!("{}-{}-{}", slug(mesh), slug(algo), metric.key());
+            let svg = boxplot_svg(
+                &format!("{stem}-"),
+                &format!("{mesh}: {algo}"),
+                name,
+                &boxes,
+                log_y,
+                &extras,
+            )?;
+            let file = format!("{FIGURES_DIR}/{stem}.svg");
             doc.figure(file, svg, caption);
         }
     }

@@ -410,12 +410,18 @@ fn report_names_every_configuration_and_draws_every_box() {
     for f in &paths.figures {
         let svg = std::fs::read_to_string(f).unwrap();
         let ids = parse_and_render(&svg);
-        let boxes: Vec<&String> = ids.iter().filter(|i| i.starts_with("box-h")).collect();
         let name = f.file_name().unwrap().to_string_lossy();
-        let want: &[&str] = if name.contains("uniform") {
-            &["box-h1", "box-h2"]
+        // Ids are "<figure stem>-box-h<H>".
+        let prefix = format!("{}-", name.trim_end_matches(".svg"));
+        let boxes: Vec<&str> = ids
+            .iter()
+            .filter_map(|i| i.strip_prefix(&prefix))
+            .filter(|i| i.starts_with("box-h"))
+            .collect();
+        let want: Vec<&str> = if name.contains("uniform") {
+            vec!["box-h1", "box-h2"]
         } else {
-            &["box-h1", "box-h2", "box-h3"]
+            vec!["box-h1", "box-h2", "box-h3"]
         };
         assert_eq!(boxes, want, "{name}");
         boxes_seen += boxes.len();
