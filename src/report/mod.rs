@@ -205,7 +205,10 @@ fn overview(doc: &mut Document, results: &Results) {
     let labels: Vec<String> = results
         .groups
         .iter()
-        .map(|(c, r)| format!("{} {} ({} runs)", c.mesh, c.label(), r.len()))
+        .map(|(c, r)| {
+            let runs = if r.len() == 1 { "run" } else { "runs" };
+            format!("{} {} ({} {runs})", c.mesh, c.label(), r.len())
+        })
         .collect();
     doc.para(format!("Configurations: {}.", labels.join("; ")));
 }
@@ -392,9 +395,9 @@ fn paper_beside(doc: &mut Document, mesh: &str, configs: &[(&Config, &[Run])]) {
     doc.list(case.notes.iter().map(|n| format!("Paper: {n}")).collect());
 }
 
-/// A number of the paper as printed there (at most two decimals), or "–".
+/// A number of the paper as printed there, or "–".
 fn paper_number(v: Option<f64>) -> String {
-    v.map_or("–".into(), |v| format!("{}", (v * 100.0).round() / 100.0))
+    v.map_or("–".into(), |v| format!("{v}"))
 }
 
 /// Fig.-8-style box plots for each algorithm with horizons.
@@ -466,13 +469,16 @@ fn box_plots(
                     caption.push_str("; the paper reports 1.33 on its Borouchaki mesh.");
                 }
             }
-            let svg = boxplot_svg(&format!("{mesh}: {algo}"), name, &boxes, log_y, &extras)?;
-            let file = format!(
-                "{FIGURES_DIR}/{}-{}-{}.svg",
-                slug(mesh),
-                slug(algo),
-                metric.key()
-            );
+            let stem = format!("{}-{}-{}", slug(mesh), slug(algo), metric.key());
+            let svg = boxplot_svg(
+                &format!("{stem}-"),
+                &format!("{mesh}: {algo}"),
+                name,
+                &boxes,
+                log_y,
+                &extras,
+            )?;
+            let file = format!("{FIGURES_DIR}/{stem}.svg");
             doc.figure(file, svg, caption);
         }
     }
@@ -503,14 +509,15 @@ fn picture_choice<'a>(
         .collect();
     algos.dedup();
     for algo in algos {
-        let best = configs
-            .iter()
-            .filter(|(c, _)| c.algo == algo)
-            .max_by(|a, b| {
-                median(&Metric::Quality.values(a.1))
-                    .total_cmp(&median(&Metric::Quality.values(b.1)))
-            });
-        out.extend(best.copied());
+        // The best median quality; the smallest horizon among equals (the cheapest to re-run).
+        let mut best: Option<(&Config, &[Run], f64)> = None;
+        for (c, r) in configs.iter().filter(|(c, _)| c.algo == algo) {
+            let q = median(&Metric::Quality.values(r));
+            if best.is_none_or(|b| q > b.2) {
+                best = Some((c, r, q));
+            }
+        }
+        out.extend(best.map(|(c, r, _)| (c, r)));
     }
     out
 }
@@ -665,10 +672,15 @@ fn method_notes(doc: &mut Document) {
         format!(
             "Differences between two sets of runs: two-sided Mann–Whitney U test (exact \
              distribution when the smaller sample has at most {} runs and there are no ties, \
-             otherwise the normal approximation with tie and continuity corrections); p-values \
-             of one family (one question, one measure) corrected with Holm's step-down method; \
-             significant means Holm p < {}.",
+             otherwise the normal approximation with tie and continuity corrections). Against a \
+             configuration run once (a deterministic baseline such as greedy with one baseline \
+             run), one value is not a sample to rank against: the other side is tested against \
+             that value with the two-sided Wilcoxon signed-rank test (T+; exact for at most {} \
+             differences without ties or zeros, otherwise normal with tie and continuity \
+             corrections). p-values of one family (one question, one measure) are corrected \
+             with Holm's step-down method; significant means Holm p < {}.",
             crate::stats::compare::EXACT_MAX_SIZE,
+            crate::stats::compare::EXACT_MAX_SIGNED_RANK,
             significance::ALPHA
         ),
         "Effect size: Vargha–Delaney A = P(first > second) + P(equal)/2; |A - 0.5| of at least \

@@ -3,8 +3,9 @@
 //! extreme values within 1.5 IQR of the box, outliers as red crosses. The time plot has a
 //! logarithmic axis and the fitted growth line whose slope gives the branching factor.
 //!
-//! Each box is an SVG `<rect>` with `id="box-h<H>"` (added after drawing, as plotters has no
-//! element ids), so tests and readers can find and count them.
+//! Each box is an SVG `<rect>` with `id="<prefix>box-h<H>"` (added after drawing, as plotters
+//! has no element ids; the prefix keeps ids unique when figures share an HTML page), so tests
+//! and readers can find and count them.
 
 use super::ReportError;
 use crate::stats::describe::{BoxStats, Growth};
@@ -44,8 +45,10 @@ pub struct Extras {
     pub fit: Option<Growth>,
 }
 
-/// Draws the box plot of `boxes` (sorted by horizon) as an SVG document.
+/// Draws the box plot of `boxes` (sorted by horizon) as an SVG document; box ids start with
+/// `id_prefix`.
 pub fn boxplot_svg(
+    id_prefix: &str,
     title: &str,
     y_desc: &str,
     boxes: &[HorizonBox],
@@ -84,7 +87,7 @@ pub fn boxplot_svg(
         }
         root.present().map_err(plot_err)?;
     }
-    Ok(tag_boxes(&svg, boxes))
+    Ok(tag_boxes(&svg, boxes, id_prefix))
 }
 
 /// The smallest and largest value to show: whiskers, outliers, baselines.
@@ -260,8 +263,8 @@ fn format_tick(v: f64) -> String {
     }
 }
 
-/// Adds `id="box-h<H>"` to each box's filled rectangle, in drawing order.
-fn tag_boxes(svg: &str, boxes: &[HorizonBox]) -> String {
+/// Adds `id="<prefix>box-h<H>"` to each box's filled rectangle, in drawing order.
+fn tag_boxes(svg: &str, boxes: &[HorizonBox], prefix: &str) -> String {
     let fill = format!(
         "fill=\"#{:02X}{:02X}{:02X}\"",
         BOX_FILL.0, BOX_FILL.1, BOX_FILL.2
@@ -275,7 +278,7 @@ fn tag_boxes(svg: &str, boxes: &[HorizonBox]) -> String {
         out.push_str("<rect ");
         if rest[i..end].contains(&fill) {
             if let Some(b) = next.next() {
-                out.push_str(&format!("id=\"box-h{}\" ", b.horizon));
+                out.push_str(&format!("id=\"{prefix}box-h{}\" ", b.horizon));
             }
         }
         rest = &rest[i + "<rect ".len()..];

@@ -49,7 +49,7 @@ impl Pair {
         };
         format!(
             "{} vs {}, {}: median {} vs {} (difference {}{}); {} at {} after Holm \
-             (U = {}, p = {}, Holm p = {}); A = {:.2}, {} {}.",
+             ({}, p = {}, Holm p = {}); A = {:.2}, {} {}.",
             self.first,
             self.second,
             self.metric_name,
@@ -59,8 +59,8 @@ impl Pair {
             ci,
             verdict,
             ALPHA,
-            fmt_u(c.test.u),
-            fmt_p(c.test.p),
+            c.test.statistic(),
+            fmt_p(c.test.p()),
             fmt_p(c.p_holm),
             c.a,
             Magnitude::of(c.a).name(),
@@ -84,8 +84,8 @@ impl Pair {
                 fmt_metric(m, c.median[1], false)
             ),
             format!("{} {}", fmt_metric(m, c.median[0] - c.median[1], true), ci),
-            fmt_u(c.test.u),
-            fmt_p(c.test.p),
+            c.test.statistic(),
+            fmt_p(c.test.p()),
             fmt_p(c.p_holm),
             format!("{:.2} ({})", c.a, Magnitude::of(c.a).name()),
             if self.significant() { "yes" } else { "no" }.to_string(),
@@ -100,7 +100,7 @@ pub fn header() -> Vec<String> {
         "measure",
         "medians",
         "median difference [95% CI]",
-        "U",
+        "test statistic",
         "p",
         "Holm p",
         "A (effect)",
@@ -120,14 +120,6 @@ fn direction(m: Metric, a: f64) -> &'static str {
         (Metric::Time, false) => "effect (first faster)",
         (_, true) => "effect (first higher)",
         (_, false) => "effect (first lower)",
-    }
-}
-
-fn fmt_u(u: f64) -> String {
-    if u.fract() == 0.0 {
-        format!("{u:.0}")
-    } else {
-        format!("{u:.1}")
     }
 }
 

@@ -1,7 +1,8 @@
 //! Comparisons of two samples: the Mann–Whitney U test (exact for small samples without ties,
-//! normal approximation with tie and continuity corrections otherwise), Holm's step-down
-//! correction of a family of p-values, the Vargha–Delaney A effect size, and a seeded bootstrap
-//! confidence interval of the difference of medians.
+//! normal approximation with tie and continuity corrections otherwise), the Wilcoxon
+//! signed-rank test of a sample against one value, Holm's step-down correction of a family of
+//! p-values, the Vargha–Delaney A effect size, and a seeded bootstrap confidence interval of the
+//! difference of medians.
 //!
 //! Conventions follow `scipy.stats.mannwhitneyu` (two-sided): `U` is the statistic of the first
 //! sample, and the exact distribution is used when either sample has at most
@@ -132,6 +133,91 @@ fn u_distribution(n1: usize, n2: usize) -> Vec<f64> {
         }
     }
     c
+}
+
+/// Largest sample for which the exact signed-rank distribution is used (no ties, no zeros).
+pub const EXACT_MAX_SIGNED_RANK: usize = 50;
+
+/// The result of a two-sided Wilcoxon signed-rank test of a sample against a value.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SignedRank {
+    /// T+: the sum of the ranks of |x_i - c| over the x_i above c (zero differences dropped).
+    pub t_plus: f64,
+    /// Non-zero differences ranked.
+    pub n: usize,
+    /// Two-sided p-value.
+    pub p: f64,
+    /// How `p` was computed.
+    pub method: PMethod,
+}
+
+/// Two-sided Wilcoxon signed-rank test of `x` against the value `c` (e.g. a deterministic
+/// baseline's single result): differences equal to zero are dropped (Wilcoxon's method), the
+/// exact distribution is used for at most [`EXACT_MAX_SIGNED_RANK`] differences without ties or
+/// zeros, otherwise the normal approximation with tie and continuity corrections.
+pub fn signed_rank(x: &[f64], c: f64) -> SignedRank {
+    let d: Vec<f64> = x.iter().map(|v| v - c).filter(|v| *v != 0.0).collect();
+    let zeros = x.len() - d.len();
+    let n = d.len();
+    if n == 0 {
+        return SignedRank {
+            t_plus: 0.0,
+            n,
+            p: 1.0,
+            method: PMethod::Normal,
+        };
+    }
+    let (ranks, ties) = ranks(d.iter().map(|v| v.abs()));
+    let t_plus: f64 = d
+        .iter()
+        .zip(&ranks)
+        .filter(|(v, _)| **v > 0.0)
+        .map(|(_, r)| r)
+        .sum::<f64>()
+        + 0.0; // An empty f64 sum is -0.0.
+    let nf = n as f64;
+    let total = nf * (nf + 1.0) / 2.0;
+    let t_min = t_plus.min(total - t_plus);
+    let has_ties = ties.iter().any(|&t| t > 1);
+    if !has_ties && zeros == 0 && n <= EXACT_MAX_SIGNED_RANK {
+        // Counts of each T for n ranks: the coefficients of prod_{i=1..n} (1 + q^i).
+        let len = n * (n + 1) / 2 + 1;
+        let mut c = vec![0.0; len];
+        c[0] = 1.0;
+        for i in 1..=n {
+            for k in (i..len).rev() {
+                c[k] += c[k - i];
+            }
+        }
+        let all: f64 = c.iter().sum();
+        let tail = c[..=(t_min.round() as usize)].iter().sum::<f64>() / all;
+        return SignedRank {
+            t_plus,
+            n,
+            p: (2.0 * tail).min(1.0),
+            method: PMethod::Exact,
+        };
+    }
+    let tie_term: f64 = ties
+        .iter()
+        .map(|&t| {
+            let t = t as f64;
+            t * t * t - t
+        })
+        .sum();
+    let var = nf * (nf + 1.0) * (2.0 * nf + 1.0) / 24.0 - tie_term / 48.0;
+    let p = if var <= 0.0 {
+        1.0
+    } else {
+        let z = ((t_plus - total / 2.0).abs() - 0.5).max(0.0) / var.sqrt();
+        (2.0 * normal_sf(z)).min(1.0)
+    };
+    SignedRank {
+        t_plus,
+        n,
+        p,
+        method: PMethod::Normal,
+    }
 }
 
 /// Upper tail `P(Z > z)` of the standard normal distribution, accurate to about 1e-7 relative
@@ -281,6 +367,41 @@ fn quantile_sorted(s: &[f64], q: f64) -> f64 {
     s[lo] + (s[hi] - s[lo]) * (pos - lo as f64)
 }
 
+/// The test behind a comparison.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Test {
+    /// Mann–Whitney U of the first sample against the second.
+    MannWhitney(MannWhitney),
+    /// Wilcoxon signed-rank of the first sample against the second's single value.
+    SignedRank(SignedRank),
+}
+
+impl Test {
+    /// The two-sided p-value.
+    pub fn p(&self) -> f64 {
+        match self {
+            Test::MannWhitney(t) => t.p,
+            Test::SignedRank(t) => t.p,
+        }
+    }
+
+    /// "U = 17" or "T+ = 5".
+    pub fn statistic(&self) -> String {
+        let fmt = |v: f64| {
+            if v.fract() == 0.0 {
+                format!("{v:.0}")
+            } else {
+                format!("{v:.1}")
+            }
+        };
+        match self {
+            Test::MannWhitney(t) => format!("U = {}", fmt(t.u)),
+            Test::SignedRank(t) => format!("T+ = {}", fmt(t.t_plus)),
+        }
+    }
+}
+
 /// Everything the report says about one pair of samples.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Comparison {
@@ -288,9 +409,9 @@ pub struct Comparison {
     pub n: [usize; 2],
     /// Medians of the two samples.
     pub median: [f64; 2],
-    /// The Mann–Whitney test of the first sample against the second.
-    pub test: MannWhitney,
-    /// Holm-adjusted p-value within the family it was compared in (equal to `test.p` until
+    /// The test of the first sample against the second.
+    pub test: Test,
+    /// Holm-adjusted p-value within the family it was compared in (equal to the test's p until
     /// [`adjust_family`] is called).
     pub p_holm: f64,
     /// Vargha–Delaney A of the first sample over the second.
@@ -302,8 +423,11 @@ pub struct Comparison {
 /// Number of bootstrap resamples used by [`compare`].
 pub const BOOTSTRAP_RESAMPLES: usize = 2000;
 
-/// Compares `x` with `y`: Mann–Whitney U, Vargha–Delaney A, and the bootstrap 95% CI of the
-/// median difference (seeded with `seed`, [`BOOTSTRAP_RESAMPLES`] resamples).
+/// Compares `x` with `y`: a test, Vargha–Delaney A, and the bootstrap 95% CI of the median
+/// difference (seeded with `seed`, [`BOOTSTRAP_RESAMPLES`] resamples). The test is Mann–Whitney
+/// U, except when `y` is a single run (a deterministic baseline run once): one value is not a
+/// sample to rank against, so `x` is tested against that value with the Wilcoxon signed-rank
+/// test.
 pub fn compare(x: &[f64], y: &[f64], seed: u64) -> Comparison {
     let med = |v: &[f64]| {
         if v.is_empty() {
@@ -312,12 +436,16 @@ pub fn compare(x: &[f64], y: &[f64], seed: u64) -> Comparison {
             median_in_place(&mut v.to_vec())
         }
     };
-    let test = mann_whitney(x, y);
+    let test = if y.len() == 1 && x.len() > 1 {
+        Test::SignedRank(signed_rank(x, y[0]))
+    } else {
+        Test::MannWhitney(mann_whitney(x, y))
+    };
     Comparison {
         n: [x.len(), y.len()],
         median: [med(x), med(y)],
         test,
-        p_holm: test.p,
+        p_holm: test.p(),
         a: vargha_delaney(x, y),
         ci95: bootstrap_median_diff_ci(x, y, 0.95, BOOTSTRAP_RESAMPLES, seed),
     }
@@ -325,7 +453,7 @@ pub fn compare(x: &[f64], y: &[f64], seed: u64) -> Comparison {
 
 /// Sets `p_holm` of every comparison of one family (one question asked of several pairs).
 pub fn adjust_family(family: &mut [Comparison]) {
-    let p: Vec<f64> = family.iter().map(|c| c.test.p).collect();
+    let p: Vec<f64> = family.iter().map(|c| c.test.p()).collect();
     for (c, adj) in family.iter_mut().zip(holm(&p)) {
         c.p_holm = adj;
     }

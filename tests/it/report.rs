@@ -9,7 +9,8 @@ use quadrecomb::quality::{CandidateTable, recombined};
 use quadrecomb::report::picture::{PictureOptions, mesh_svg};
 use quadrecomb::report::{self, ReportOptions};
 use quadrecomb::stats::compare::{
-    Magnitude, PMethod, bootstrap_median_diff_ci, holm, mann_whitney, vargha_delaney,
+    Magnitude, PMethod, Test, bootstrap_median_diff_ci, compare, holm, mann_whitney, signed_rank,
+    vargha_delaney,
 };
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -98,6 +99,55 @@ fn mann_whitney_nine_against_nine_without_ties_uses_normal() {
     let r = mann_whitney(&x, &y);
     assert_eq!(r.u, 58.0);
     assert!(close(r.p, 0.132_919_458_185_318_92, 1e-6), "{}", r.p);
+}
+
+#[test]
+#[allow(clippy::approx_constant)] // 3.14 is data, not pi.
+fn signed_rank_matches_scipy() {
+    // scipy 1.17.1 `wilcoxon(d)` reports min(T+, T-); p two-sided.
+    // Exact (n = 9, no ties): differences of the nine pairs above; wilcoxon(x - y,
+    // method='exact') = (5.0, 0.0390625) = 2 * 10/512.
+    let x = [1.83, 0.50, 1.62, 2.48, 1.68, 1.88, 1.55, 3.06, 1.30];
+    let y = [0.878, 0.647, 0.598, 2.05, 1.06, 1.29, 1.06, 3.14, 1.29];
+    let d: Vec<f64> = x.iter().zip(&y).map(|(a, b)| a - b).collect();
+    let r = signed_rank(&d, 0.0);
+    assert_eq!(r.method, PMethod::Exact);
+    assert_eq!(r.t_plus.min(45.0 - r.t_plus), 5.0);
+    assert!(close(r.p, 0.039_062_5, 1e-12), "{}", r.p);
+    // Ties among |d|: normal approximation; wilcoxon(d, method='approx', correction=True)
+    // = (5.0, 0.008437510017470243).
+    let d = [1.5, -0.5, 2.0, 3.0, 2.0, -1.0, 4.0, 2.5, 3.5, 1.0, 0.5, 2.0];
+    let r = signed_rank(&d, 0.0);
+    assert_eq!(r.method, PMethod::Normal);
+    assert_eq!(r.t_plus.min(78.0 - r.t_plus), 5.0);
+    assert!(close(r.p, 0.008_437_510_017_470_243, 1e-6), "{}", r.p);
+    // n = 60 > 50: normal; (1..=60) - 20.5 against 0: (410.0, 0.00020386339085503644).
+    let d: Vec<f64> = (1..=60).map(|v| f64::from(v) - 20.5).collect();
+    let r = signed_rank(&d, 0.0);
+    assert_eq!(r.method, PMethod::Normal);
+    assert_eq!(r.t_plus.min(1830.0 - r.t_plus), 410.0);
+    assert!(close(r.p, 2.038_633_908_550_364_4e-4, 1e-6), "{}", r.p);
+    // The same test against a constant c is the test of x - c against 0.
+    let shifted: Vec<f64> = d.iter().map(|v| v + 7.0).collect();
+    assert_eq!(signed_rank(&shifted, 7.0), r);
+}
+
+#[test]
+fn a_single_baseline_run_is_tested_with_signed_ranks() {
+    // 20 runs all above a deterministic baseline's one value: Mann–Whitney could not go below
+    // p = 2/21, the signed-rank test against the value can (exact: 2 / 2^20).
+    let x: Vec<f64> = (1..=20).map(f64::from).collect();
+    let c = compare(&x, &[0.5], SEED);
+    match c.test {
+        Test::SignedRank(t) => {
+            assert_eq!(t.t_plus, 210.0);
+            assert!(close(t.p, 2.0 / 1_048_576.0, 1e-12), "{}", t.p);
+        }
+        other => panic!("expected a signed-rank test, got {other:?}"),
+    }
+    assert_eq!(c.a, 1.0);
+    let c = compare(&x, &[0.5, 0.7], SEED);
+    assert!(matches!(c.test, Test::MannWhitney(_)));
 }
 
 #[test]
@@ -360,12 +410,18 @@ fn report_names_every_configuration_and_draws_every_box() {
     for f in &paths.figures {
         let svg = std::fs::read_to_string(f).unwrap();
         let ids = parse_and_render(&svg);
-        let boxes: Vec<&String> = ids.iter().filter(|i| i.starts_with("box-h")).collect();
         let name = f.file_name().unwrap().to_string_lossy();
-        let want: &[&str] = if name.contains("uniform") {
-            &["box-h1", "box-h2"]
+        // Ids are "<figure stem>-box-h<H>".
+        let prefix = format!("{}-", name.trim_end_matches(".svg"));
+        let boxes: Vec<&str> = ids
+            .iter()
+            .filter_map(|i| i.strip_prefix(&prefix))
+            .filter(|i| i.starts_with("box-h"))
+            .collect();
+        let want: Vec<&str> = if name.contains("uniform") {
+            vec!["box-h1", "box-h2"]
         } else {
-            &["box-h1", "box-h2", "box-h3"]
+            vec!["box-h1", "box-h2", "box-h3"]
         };
         assert_eq!(boxes, want, "{name}");
         boxes_seen += boxes.len();
@@ -400,6 +456,27 @@ fn report_states_which_differences_are_significant() {
         .expect("row for selective h=2 vs h=1");
     assert!(line.ends_with("| yes |"), "{line}");
     assert!(line.contains("(large)"), "{line}");
+
+    // Greedy run once (the runner's default for deterministic baselines): the others are tested
+    // against its value with signed ranks, and selective is still significantly better.
+    let runs = tmp.path().join("runs.jsonl");
+    let kept: Vec<String> = std::fs::read_to_string(&runs)
+        .unwrap()
+        .lines()
+        .filter(|l| {
+            let r: RunRecord = serde_json::from_str(l).unwrap();
+            r.algo != "greedy" || r.run == 0
+        })
+        .map(String::from)
+        .collect();
+    std::fs::write(&runs, kept.join("\n") + "\n").unwrap();
+    let md = std::fs::read_to_string(report::write(tmp.path(), &opts).unwrap().markdown).unwrap();
+    let line = md
+        .lines()
+        .find(|l| l.starts_with("| selective h=3 vs greedy | quality"))
+        .expect("row for selective h=3 vs greedy");
+    assert!(line.contains("| T+ = 820 |"), "{line}");
+    assert!(line.ends_with("| yes |"), "{line}");
 }
 
 #[test]
