@@ -13,6 +13,10 @@ pub struct Args {
     /// Grid sizes in triangles (comma-separated; each is rounded to a grid of squares).
     #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 30_000, 100_000, 300_000, 1_000_000])]
     sizes: Vec<usize>,
+    /// Sizes of the jittered equilateral lattices (near-equilateral triangles like a frontal
+    /// Delaunay mesh: a much harder matching than the right-triangle grids).
+    #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 30_000, 100_000, 200_000])]
+    lattice_sizes: Vec<usize>,
     /// Built-in meshes or mesh files to time as well (skipped with a note when not loadable).
     #[arg(long, value_delimiter = ',', default_values_t = ["borouchaki".to_string(), "sphere".to_string()])]
     meshes: Vec<String>,
@@ -65,6 +69,24 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if points.len() >= 2 {
         println!(
             "growth exponent (least-squares slope of log time vs log triangles, grids): {:.2}",
+            slope(&points)
+        );
+    }
+    let mut points = Vec::new();
+    for &n in &args.lattice_sizes {
+        let mesh = lattice(n, 2);
+        let repeat = if mesh.num_triangles() > 50_000 {
+            args.repeat.min(2)
+        } else {
+            args.repeat
+        };
+        let (opt, t) = time(&mesh, repeat);
+        print_row(&format!("lattice {n}"), &mesh, &opt, t, None);
+        points.push((mesh.num_triangles() as f64, t));
+    }
+    if points.len() >= 2 {
+        println!(
+            "growth exponent (least-squares slope of log time vs log triangles, lattices): {:.2}",
             slope(&points)
         );
     }
@@ -169,4 +191,46 @@ pub fn grid(n: usize, seed: u64) -> Mesh {
         ..MeshData::default()
     })
     .expect("a jittered grid is a valid mesh")
+}
+
+/// A jittered equilateral triangle lattice of about `n` triangles (rows offset by half a
+/// step, interior vertices moved by up to 0.15 of an edge), seeded.
+pub fn lattice(n: usize, seed: u64) -> Mesh {
+    let cells = (n / 2).max(1);
+    let nx = ((cells as f64).sqrt().round() as usize).max(1);
+    let ny = cells.div_ceil(nx);
+    let h = 3f64.sqrt() / 2.0;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut vertices = Vec::with_capacity((nx + 1) * (ny + 1));
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let interior = i > 0 && i < nx && j > 0 && j < ny;
+            let (dx, dy) = if interior {
+                (rng.random_range(-0.15..0.15), rng.random_range(-0.15..0.15))
+            } else {
+                (0.0, 0.0)
+            };
+            let shift = if j % 2 == 1 { 0.5 } else { 0.0 };
+            vertices.push([i as f64 + shift + dx, j as f64 * h + dy, 0.0]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut triangles = Vec::with_capacity(2 * nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            if j % 2 == 0 {
+                triangles.push([id(i, j), id(i + 1, j), id(i, j + 1)]);
+                triangles.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+            } else {
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            }
+        }
+    }
+    Mesh::new(MeshData {
+        vertices,
+        triangles,
+        ..MeshData::default()
+    })
+    .expect("a jittered lattice is a valid mesh")
 }
