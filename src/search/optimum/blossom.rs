@@ -12,8 +12,8 @@
 //! Algorithm. A greedy jump-start sets vertex duals to half the cheapest incident cost, raises
 //! each free vertex to its tightest edge, matches tight edges between free vertices and
 //! augments along tight paths of length three. Then Edmonds' primal–dual method with blossoms:
-//! first a short single-tree search from each free vertex (stopped after a few events, its
-//! dual progress kept), then one forest of trees from all remaining free vertices that share
+//! two rounds of short single-tree searches from each free vertex (stopped after 64, then 512
+//! events, their dual progress kept), then one forest of trees from all remaining free vertices that share
 //! one dual step; two trees that meet augment and dissolve, the others go on. Dual changes are
 //! lazy: a tree node stores the step `delta` at which it joined and its dual moves by
 //! `+/-(delta - join)`; a leaf reaches its top-level node through a handle that shrinks and
@@ -96,8 +96,9 @@ impl Graph {
     }
 }
 
-/// Events a short single-tree search may use before it is handed to the forest.
-const SHORT_SEARCH_EVENTS: usize = 64;
+/// Events a short single-tree search may use before it is stopped, per round (all free
+/// vertices get a search in each round); what remains goes to the forest.
+const SHORT_SEARCH_EVENTS: [usize; 2] = [64, 512];
 
 /// Counters of one solve, for benchmarks and tests.
 #[derive(Debug, Clone, Copy, Default)]
@@ -416,9 +417,11 @@ impl Solver {
             .count();
         // Short single-tree searches first: most free vertices find a partner nearby, and a
         // search that runs long is stopped (its dual progress is kept) for the forest.
-        for r in 0..self.n as u32 {
-            if self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1 {
-                self.grow_forest(g, &[r], SHORT_SEARCH_EVENTS);
+        for budget in SHORT_SEARCH_EVENTS {
+            for r in 0..self.n as u32 {
+                if self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1 {
+                    self.grow_forest(g, &[r], budget);
+                }
             }
         }
         let roots: Vec<u32> = (0..self.n as u32)
