@@ -1,22 +1,27 @@
 //! Sparse primal–dual blossom algorithm: minimum-cost perfect matching in integers, used for
 //! the maximum-weight matching of maximum cardinality.
 //!
-//! Formulation. Weights `w` become costs `c = 2 (w_max - w)` (even, so that every dual step is
-//! an integer). Each connected component that has no perfect matching receives "dummy" vertices
-//! joined to all its vertices at cost 0, one per vertex that must stay unmatched: an odd
-//! component gets one up front, and a search tree that gets stuck (a Hungarian tree: no perfect
-//! matching exists) adds one more. A perfect matching of the augmented graph is then exactly a
-//! maximum-cardinality matching of the graph, and the cheapest one is the heaviest.
+//! Formulation. Weights `w` become costs `c = 4 (w_max - w)` (even, and every jump-start dual
+//! even, so that every dual step is an integer). Each connected component that has no perfect
+//! matching receives "dummy" vertices joined to all its vertices at cost 0, one per vertex that
+//! must stay unmatched: an odd component gets one up front, and search trees that get stuck
+//! (Hungarian trees: no perfect matching exists) add one each. A perfect matching of the
+//! augmented graph is then exactly a maximum-cardinality matching of the graph, and the
+//! cheapest one is the heaviest.
 //!
 //! Algorithm. A greedy jump-start sets vertex duals to half the cheapest incident cost, raises
-//! each vertex to its tightest edge and matches tight edges between free vertices; this leaves
-//! few free vertices. Each free vertex then grows one alternating tree (Edmonds' primal–dual
-//! method with blossoms). Dual changes inside the tree are lazy: a tree node stores the time
-//! `delta` at which it joined, and its dual moves by `+/-(delta - join)`; events (an edge
-//! becoming tight, a minus blossom's dual reaching zero) sit in a binary heap keyed by the time
-//! at which they happen, so a dual step costs one heap pop instead of a scan of the graph.
-//! Blossoms are shrunk when two plus nodes meet and expanded lazily, only when their dual
-//! reaches zero as a minus node; blossoms outlive their tree.
+//! each free vertex to its tightest edge, matches tight edges between free vertices and
+//! augments along tight paths of length three. Then Edmonds' primal–dual method with blossoms:
+//! two rounds of short single-tree searches from each free vertex (stopped after 64, then 512
+//! events, their dual progress kept), then one forest of trees from all remaining free vertices that share
+//! one dual step; two trees that meet augment and dissolve, the others go on. Dual changes are
+//! lazy: a tree node stores the step `delta` at which it joined and its dual moves by
+//! `+/-(delta - join)`; a leaf reaches its top-level node through a handle that shrinks and
+//! expansions pass small-to-large. Events (an edge becoming tight, a minus blossom's dual
+//! reaching zero) sit in a binary heap keyed by the step at which they happen, so a dual step
+//! costs one heap pop instead of a scan of the graph. Blossoms are shrunk when two plus nodes
+//! of one tree meet and expanded lazily, only when their dual reaches zero as a minus node;
+//! blossoms outlive their tree.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -91,8 +96,9 @@ impl Graph {
     }
 }
 
-/// Events a short single-tree search may use before it is handed to the forest.
-const SHORT_SEARCH_EVENTS: usize = 64;
+/// Events a short single-tree search may use before it is stopped, per round (all free
+/// vertices get a search in each round); what remains goes to the forest.
+const SHORT_SEARCH_EVENTS: [usize; 2] = [64, 512];
 
 /// Counters of one solve, for benchmarks and tests.
 #[derive(Debug, Clone, Copy, Default)]
@@ -411,9 +417,11 @@ impl Solver {
             .count();
         // Short single-tree searches first: most free vertices find a partner nearby, and a
         // search that runs long is stopped (its dual progress is kept) for the forest.
-        for r in 0..self.n as u32 {
-            if self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1 {
-                self.grow_forest(g, &[r], SHORT_SEARCH_EVENTS);
+        for budget in SHORT_SEARCH_EVENTS {
+            for r in 0..self.n as u32 {
+                if self.mate[r as usize] == NONE && self.comp_size(self.comp[r as usize]) > 1 {
+                    self.grow_forest(g, &[r], budget);
+                }
             }
         }
         let roots: Vec<u32> = (0..self.n as u32)
@@ -1270,5 +1278,87 @@ impl Solver {
             }
         }
         (a != NONE).then_some(a)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn solve_edges(n: usize, edges: &[(u32, u32, i64)]) -> (Vec<(u32, u32)>, i64) {
+        let g = Graph::from_edges(n, edges.iter().copied());
+        let m = solve(&g);
+        m.check(&g).expect("certificate");
+        (m.pairs().collect(), m.weight(&g))
+    }
+
+    #[test]
+    fn path_prefers_two_light_edges_over_one_heavy() {
+        // Maximum cardinality first: 2 pairs of weight 1 beat 1 pair of weight 100.
+        let (pairs, w) = solve_edges(4, &[(0, 1, 1), (1, 2, 100), (2, 3, 1)]);
+        assert_eq!(pairs, vec![(0, 1), (2, 3)]);
+        assert_eq!(w, 2);
+    }
+
+    #[test]
+    fn odd_cycle_leaves_the_cheapest_vertex() {
+        // Triangle 0-1-2 plus pendant 3 at 0: one vertex must stay single; the best pairs are
+        // 0-3 (5) and 1-2 (7).
+        let (pairs, w) = solve_edges(4, &[(0, 1, 9), (1, 2, 7), (2, 0, 1), (0, 3, 5)]);
+        assert_eq!(pairs, vec![(0, 3), (1, 2)]);
+        assert_eq!(w, 12);
+        // A lone triangle: one pair, the heaviest.
+        let (pairs, w) = solve_edges(3, &[(0, 1, 2), (1, 2, 3), (2, 0, 4)]);
+        assert_eq!((pairs.len(), w), (1, 4));
+    }
+
+    #[test]
+    fn blossom_is_needed() {
+        // Two triangles joined by a bridge: the perfect matching uses the bridge.
+        let e = [
+            (0, 1, 5),
+            (1, 2, 5),
+            (2, 0, 5),
+            (3, 4, 5),
+            (4, 5, 5),
+            (5, 3, 5),
+            (2, 3, 0),
+        ];
+        let (pairs, w) = solve_edges(6, &e);
+        assert_eq!(pairs.len(), 3);
+        assert!(pairs.contains(&(2, 3)));
+        assert_eq!(w, 10);
+    }
+
+    #[test]
+    fn even_component_without_perfect_matching() {
+        // A claw (star with three leaves): only one pair; the heaviest spoke.
+        let (pairs, w) = solve_edges(4, &[(0, 1, 3), (0, 2, 8), (0, 3, 5)]);
+        assert_eq!(pairs, vec![(0, 2)]);
+        assert_eq!(w, 8);
+    }
+
+    #[test]
+    fn isolated_vertices_and_empty_graph() {
+        let (pairs, w) = solve_edges(3, &[]);
+        assert!(pairs.is_empty() && w == 0);
+        let (pairs, _) = solve_edges(0, &[]);
+        assert!(pairs.is_empty());
+    }
+
+    #[test]
+    fn ties_give_any_perfect_matching() {
+        // All weights equal on an even cycle with chords: any perfect matching is optimal.
+        let e = [
+            (0, 1, 7),
+            (1, 2, 7),
+            (2, 3, 7),
+            (3, 4, 7),
+            (4, 5, 7),
+            (5, 0, 7),
+            (0, 3, 7),
+        ];
+        let (pairs, w) = solve_edges(6, &e);
+        assert_eq!((pairs.len(), w), (3, 21));
     }
 }
