@@ -5,6 +5,7 @@ mod io;
 mod meshes;
 mod optimum;
 mod report;
+mod results;
 mod runner;
 mod search;
 mod search_oracle;

@@ -1,0 +1,109 @@
+//! The committed `results/` still match what the code produces: the summary is the statistics
+//! of the committed runs, and a reduced sweep with the same seeds reproduces the committed
+//! records (every field but the wall-clock time).
+
+use crate::util::{repo_path, run_in};
+use quadrecomb::experiment::manifest::Manifest;
+use quadrecomb::experiment::record::RunRecord;
+use quadrecomb::experiment::{store, summary};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// The committed result directories and, for each, the reduced sweep re-run by the test.
+const CASES: &[(&str, &[&str], &str, u32)] = &[
+    (
+        "results/borouchaki",
+        &["selective", "greedy", "greedy-nocrit"],
+        "1..2",
+        2,
+    ),
+    ("results/sphere", &["selective", "greedy"], "1..3", 3),
+];
+
+fn committed(dir: &Path) -> Option<(Manifest, Vec<RunRecord>)> {
+    let runs = dir.join("runs.jsonl");
+    if !runs.exists() {
+        return None;
+    }
+    let manifest: Manifest =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    let records = store::read(&runs).unwrap().records;
+    Some((manifest, records))
+}
+
+#[test]
+fn committed_summaries_are_the_statistics_of_the_committed_runs() {
+    let mut checked = 0;
+    for (rel, ..) in CASES {
+        let dir = repo_path(rel);
+        let Some((_, records)) = committed(&dir) else {
+            eprintln!("NOTE: {rel} has no committed runs");
+            continue;
+        };
+        let ours = summary::to_csv(&summary::summarize(&records));
+        let theirs = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
+        assert_eq!(ours, theirs, "{rel}/summary.csv is stale: regenerate it");
+        checked += 1;
+    }
+    assert!(checked > 0, "no committed results found under results/");
+}
+
+#[test]
+fn a_reduced_sweep_reproduces_the_committed_records() {
+    for (rel, algos, horizons, runs) in CASES {
+        let dir = repo_path(rel);
+        let Some((manifest, records)) = committed(&dir) else {
+            continue;
+        };
+        let backend = &manifest.backend;
+        // Qualities must come from the same backend for bit-identical searches.
+        let flag = if backend == "cpu-twin" {
+            "cpu"
+        } else if backend.contains("llvmpipe") {
+            "gpu"
+        } else {
+            eprintln!("SKIPPED: {rel} was made with backend `{backend}`, not reproducible here");
+            continue;
+        };
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("out");
+        let mesh = &manifest.spec.meshes[0].name;
+        let seed = manifest.spec.seed.to_string();
+        let runs = runs.to_string();
+        let mut args = vec!["sweep", "--mesh", mesh, "--algo"];
+        args.extend_from_slice(algos);
+        args.extend_from_slice(&[
+            "--horizons",
+            horizons,
+            "--runs",
+            &runs,
+            "--seed",
+            &seed,
+            "--backend",
+            flag,
+            "--no-report",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let output = run_in(tmp.path(), &args);
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let by_key: HashMap<_, _> = records.iter().map(|r| (r.key(), r)).collect();
+        let fresh = store::read(&out.join("runs.jsonl")).unwrap().records;
+        assert!(!fresh.is_empty());
+        for rec in &fresh {
+            let old = by_key
+                .get(&rec.key())
+                .unwrap_or_else(|| panic!("{rel}: committed results lack {:?}", rec.key()));
+            assert!(
+                rec.same_result(old),
+                "{rel}: {:?} differs from the committed run:\n{rec:?}\nvs\n{old:?}",
+                rec.key()
+            );
+        }
+    }
+}
