@@ -256,76 +256,9 @@ fn jittered_grid_mesh(n: u32, jitter: f64, z: impl Fn(f64, f64) -> f64, seed: u6
 }
 
 fn icosphere(subdiv: u32) -> Mesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..subdiv {
-        let mut mid = std::collections::HashMap::new();
-        let mut midpoint = |a: u32, b: u32, v: &mut Vec<[f64; 3]>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let (p, q) = (v[a as usize], v[b as usize]);
-                v.push([0, 1, 2].map(|k| 0.5 * (p[k] + q[k])));
-                v.len() as u32 - 1
-            })
-        };
-        let mut g = Vec::new();
-        for [a, b, c] in f {
-            let (ab, bc, ca) = (
-                midpoint(a, b, &mut v),
-                midpoint(b, c, &mut v),
-                midpoint(c, a, &mut v),
-            );
-            g.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = g;
-    }
-    for p in &mut v {
-        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        *p = p.map(|x| x / r);
-    }
-    Mesh::new(MeshData {
-        vertices: v,
-        triangles: f,
-        ..MeshData::default()
-    })
-    .unwrap()
+    quadrecomb::mesh::generate::icosphere(subdiv)
 }
 
-/// `m` with every vertex mapped by `f`.
 fn mapped(m: &Mesh, f: impl Fn([f64; 3]) -> [f64; 3]) -> Mesh {
     Mesh::new(MeshData {
         vertices: m.vertices.iter().map(|&p| f(p)).collect(),
