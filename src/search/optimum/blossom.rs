@@ -105,7 +105,7 @@ const SHORT_SEARCH_EVENTS: [usize; 2] = [64, 512];
 pub struct Stats {
     /// Vertices left free by the greedy jump-start (roots of trees).
     pub free_after_greedy: usize,
-    /// Trees grown (augmentations plus stuck trees).
+    /// Trees grown: short single-tree searches plus the trees of the final forest.
     pub trees: usize,
     /// Blossoms shrunk.
     pub shrinks: usize,
