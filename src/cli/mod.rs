@@ -88,3 +88,29 @@ pub fn describe(err: &anyhow::Error) -> String {
     }
     out
 }
+
+/// Checks before any work that an output path names a `.msh` or `.vtu` file.
+pub fn check_mesh_output(path: Option<&std::path::Path>) -> Result<(), BadInput> {
+    match path {
+        Some(p) if !matches!(p.extension().and_then(|e| e.to_str()), Some("msh" | "vtu")) => {
+            Err(BadInput(format!(
+                "output {}: expected a .msh or .vtu file name",
+                p.display()
+            )))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Writes a recombined mesh as VTU (`.vtu`) or MSH 4.1 ASCII (anything else).
+pub fn write_mesh_output(
+    path: &std::path::Path,
+    mesh: &quadrecomb::mesh::Mesh,
+    rec: &quadrecomb::mesh::Recombined,
+) -> Result<(), quadrecomb::mesh::ReadError> {
+    if path.extension().is_some_and(|e| e == "vtu") {
+        quadrecomb::mesh::vtu::write(path, mesh, rec)
+    } else {
+        quadrecomb::mesh::msh::write(path, mesh, rec)
+    }
+}

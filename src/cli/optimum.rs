@@ -1,7 +1,8 @@
 //! `quadrecomb optimum`: the exact optimum (maximum-weight matching of maximum cardinality).
 
-use quadrecomb::quality::CandidateTable;
+use quadrecomb::quality::{self, CandidateTable};
 use quadrecomb::search::optimum;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
@@ -15,9 +16,13 @@ pub struct Args {
     /// slackness); exits with an error if it fails. Not counted in `time_s`.
     #[arg(long)]
     check: bool,
+    /// Write the optimal quad mesh (quads and leftover triangles): .msh (MSH 4.1) or .vtu.
+    #[arg(short = 'o', long)]
+    output: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    super::check_mesh_output(args.output.as_deref())?;
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
     let table = CandidateTable::build(&mesh);
     let (opt, report) = optimum::solve_certified(&mesh, &table, args.check);
@@ -32,6 +37,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(Err(e)) => anyhow::bail!("certificate check failed: {e}"),
         None => None,
     };
+    if let Some(path) = &args.output {
+        super::write_mesh_output(
+            path,
+            &mesh,
+            &quality::recombined(&mesh, &table, &opt.chosen),
+        )?;
+    }
     if args.json {
         let mut v = serde_json::json!({
             "mesh": args.mesh,

@@ -51,16 +51,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         AlgoName::Selective => "selective",
     };
     let algo = Algo::from_name(name, args.horizon).map_err(|e| BadInput(e.to_string()))?;
-    if let Some(out) = &args.output {
-        let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("");
-        if !matches!(ext, "msh" | "vtu") {
-            return Err(BadInput(format!(
-                "output {}: expected a .msh or .vtu file name",
-                out.display()
-            ))
-            .into());
-        }
-    }
+    super::check_mesh_output(args.output.as_deref())?;
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
     let table = CandidateTable::build(&mesh);
     let out = search::run(&mesh, &table, algo, args.seed);
@@ -73,11 +64,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .map(|o| 100.0 * out.quality / o.quality);
     if let Some(path) = &args.output {
         let rec = quality::recombined(&mesh, &table, &out.chosen);
-        if path.extension().is_some_and(|e| e == "vtu") {
-            quadrecomb::mesh::vtu::write(path, &mesh, &rec)?;
-        } else {
-            quadrecomb::mesh::msh::write(path, &mesh, &rec)?;
-        }
+        super::write_mesh_output(path, &mesh, &rec)?;
     }
     let horizon = match algo {
         Algo::GreedyNocrit | Algo::Greedy => None,
