@@ -525,12 +525,6 @@ impl<'a> State<'a> {
             self.nseed[s] = self.queue[s].len();
         }
         let nb = &self.mesh.topology.neighbours;
-        fn gfind(g: &[u8; 4], mut s: u8) -> u8 {
-            while g[s as usize] != s {
-                s = g[s as usize];
-            }
-            s
-        }
         loop {
             // The verdict can only change when a search runs dry or two groups meet.
             let mut event = false;
@@ -551,11 +545,17 @@ impl<'a> State<'a> {
                         self.owner[ui] = s as u8;
                         self.queue[s].push(u);
                     } else {
+                        // Groups are kept flat (`group[s]` is the root), so a meeting is
+                        // one comparison; a merge relabels the (at most 4) members.
                         let o = self.owner[ui];
-                        if o != BLOCKED {
-                            let (a, b) = (gfind(&self.group, o), gfind(&self.group, s as u8));
+                        if o != BLOCKED && o != s as u8 {
+                            let (a, b) = (self.group[o as usize], self.group[s]);
                             if a != b {
-                                self.group[a as usize] = b;
+                                for g in self.group[..ns].iter_mut() {
+                                    if *g == a {
+                                        *g = b;
+                                    }
+                                }
                                 event = true;
                             }
                         }
@@ -574,14 +574,14 @@ impl<'a> State<'a> {
             let mut gsize = [0u32; 4];
             let mut gdone = [true; 4];
             for s in 0..ns {
-                let g = gfind(&self.group, s as u8) as usize;
+                let g = self.group[s] as usize;
                 gsize[g] += self.queue[s].len() as u32;
                 if self.head[s] < self.queue[s].len() {
                     gdone[g] = false;
                 }
             }
             for s in 0..ns {
-                if gfind(&self.group, s as u8) as usize == s {
+                if self.group[s] as usize == s {
                     groups += 1;
                     if !gdone[s] {
                         running += 1;
@@ -604,7 +604,7 @@ impl<'a> State<'a> {
                 let mut odd = 0;
                 let mut known = 0;
                 for s in 0..ns {
-                    if gfind(&self.group, s as u8) as usize == s && gdone[s] {
+                    if self.group[s] as usize == s && gdone[s] {
                         odd += gsize[s] & 1;
                         known += gsize[s];
                     }
@@ -613,10 +613,6 @@ impl<'a> State<'a> {
                     odd += (total - known) & 1;
                 } else {
                     debug_assert_eq!(known, total, "parts add up to the polder");
-                }
-                for s in 0..ns {
-                    let g = gfind(&self.group, s as u8);
-                    self.group[s] = g;
                 }
                 // Certificate: the finished parts whole; for the running part, the paths
                 // along which its searches met, or only its seeds when it is one search
@@ -977,12 +973,14 @@ impl<'a> State<'a> {
             }
         }
         for x in [t0, t1] {
-            for i in 0..self.watch[x as usize].len() {
-                let (c2, ver) = self.watch[x as usize][i];
+            // Marking touches no watch list: iterate the list taken out, then put it back.
+            let list = std::mem::take(&mut self.watch[x as usize]);
+            for &(c2, ver) in &list {
                 if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
                     self.mark(c2);
                 }
             }
+            self.watch[x as usize] = list;
         }
         if !self.changed.is_empty() {
             for i in 0..self.split.len() {
