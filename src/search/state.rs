@@ -44,7 +44,12 @@ const KIND_SPLIT: u8 = 2;
 /// one part. Depends on those components staying distinct.
 const KIND_DISTINCT: u8 = 3;
 /// Owner mark for the two triangles being removed during a search.
-const BLOCKED: u8 = u8::MAX;
+const BLOCKED: u32 = 7;
+/// Search mark of a used triangle: above every epoch's marks, so one comparison tells an
+/// unvisited remaining triangle from a visited or used one.
+const DEAD: u32 = u32::MAX;
+/// Epochs stay below this so that `epoch << 3 | owner` never reaches `DEAD`.
+const EPOCH_LIMIT: u32 = (1 << 29) - 2;
 
 /// One reversible change.
 #[derive(Debug, Clone, Copy)]
@@ -135,8 +140,9 @@ pub struct State<'a> {
     quality: Vec<f64>,
     log: Vec<Op>,
     // ---- scratch ----
+    /// Search marks: `epoch << 3 | owner` (owner = search index or `BLOCKED`) for a triangle
+    /// visited by the current search, lower for an unvisited one, `DEAD` for a used one.
     stamp: Vec<u32>,
-    owner: Vec<u8>,
     epoch: u32,
     queue: [Vec<u32>; 4],
     head: [usize; 4],
@@ -276,7 +282,6 @@ impl<'a> State<'a> {
             quality: vec![0.0],
             log: Vec::new(),
             stamp: vec![0; nt],
-            owner: vec![0; nt],
             epoch: 0,
             queue: Default::default(),
             head: [0; 4],
@@ -418,12 +423,18 @@ impl<'a> State<'a> {
         let [t0, t1] = self.table.pairs[c as usize];
         let n = self.cand_nb[c as usize];
         let q = self.table.quads[c as usize];
+        // Group label of each neighbour slot, kept flat: joining relabels the 4 slots.
         let mut root = [0u8, 1, 2, 3];
-        fn find(r: &mut [u8; 4], mut i: u8) -> u8 {
-            while r[i as usize] != i {
-                i = r[i as usize];
+        #[inline(always)]
+        fn join(r: &mut [u8; 4], a: usize, b: usize) {
+            let (x, y) = (r[a], r[b]);
+            if x != y {
+                for k in r.iter_mut() {
+                    if *k == y {
+                        *k = x;
+                    }
+                }
             }
-            i
         }
         let mut live = [false; 4];
         for i in 0..4 {
@@ -435,15 +446,13 @@ impl<'a> State<'a> {
             }
             for j in 0..i {
                 if live[j] && n[i] == n[j] {
-                    let (a, b) = (find(&mut root, i as u8), find(&mut root, j as u8));
-                    root[a as usize] = b;
+                    join(&mut root, i, j);
                 }
             }
             let j = (i + 1) % 4;
             let v = q[j] as usize;
             if live[j] && self.closed[v] && self.dead_count[v] == 0 {
-                let (a, b) = (find(&mut root, i as u8), find(&mut root, j as u8));
-                root[a as usize] = b;
+                join(&mut root, i, j);
             }
         }
         // Distinct groups of live neighbours: one search per group.
@@ -451,7 +460,7 @@ impl<'a> State<'a> {
         let mut ns = 0usize;
         for i in 0..4 {
             if live[i] {
-                let r = find(&mut root, i as u8) as usize;
+                let r = root[i] as usize;
                 if sid[r] == u8::MAX {
                     sid[r] = ns as u8;
                     ns += 1;
@@ -494,16 +503,18 @@ impl<'a> State<'a> {
             };
         }
         self.searches += 1;
-        self.epoch = self.epoch.wrapping_add(1);
-        if self.epoch == 0 {
-            self.stamp.iter_mut().for_each(|s| *s = 0);
+        self.epoch += 1;
+        if self.epoch > EPOCH_LIMIT {
+            self.stamp.iter_mut().for_each(|s| {
+                if *s != DEAD {
+                    *s = 0;
+                }
+            });
             self.epoch = 1;
         }
-        let ep = self.epoch;
-        self.stamp[t0 as usize] = ep;
-        self.owner[t0 as usize] = BLOCKED;
-        self.stamp[t1 as usize] = ep;
-        self.owner[t1 as usize] = BLOCKED;
+        let base = self.epoch << 3;
+        self.stamp[t0 as usize] = base | BLOCKED;
+        self.stamp[t1 as usize] = base | BLOCKED;
         self.nsearch = ns;
         for s in 0..ns {
             self.queue[s].clear();
@@ -513,10 +524,9 @@ impl<'a> State<'a> {
         for i in 0..4 {
             if live[i] {
                 let t = n[i] as usize;
-                if self.stamp[t] != ep {
-                    let s = sid[find(&mut root, i as u8) as usize];
-                    self.stamp[t] = ep;
-                    self.owner[t] = s;
+                if self.stamp[t] < base {
+                    let s = sid[root[i] as usize];
+                    self.stamp[t] = base | s as u32;
                     self.queue[s as usize].push(t as u32);
                 }
             }
@@ -525,43 +535,46 @@ impl<'a> State<'a> {
             self.nseed[s] = self.queue[s].len();
         }
         let nb = &self.mesh.topology.neighbours;
-        fn gfind(g: &[u8; 4], mut s: u8) -> u8 {
-            while g[s as usize] != s {
-                s = g[s as usize];
-            }
-            s
-        }
         loop {
             // The verdict can only change when a search runs dry or two groups meet.
             let mut event = false;
             for s in 0..ns {
+                // Disjoint field borrows: the hot loop reads no other state.
+                let queue = &mut self.queue[s];
+                let stamp = &mut self.stamp;
+                let group = &mut self.group;
                 let h = self.head[s];
-                if h == self.queue[s].len() {
+                if h == queue.len() {
                     continue;
                 }
-                let x = self.queue[s][h];
+                let x = queue[h];
                 self.head[s] = h + 1;
+                let own = base | s as u32;
                 for &u in &nb[x as usize] {
-                    if u == NONE || !self.alive[u as usize] {
+                    if u == NONE {
                         continue;
                     }
                     let ui = u as usize;
-                    if self.stamp[ui] != ep {
-                        self.stamp[ui] = ep;
-                        self.owner[ui] = s as u8;
-                        self.queue[s].push(u);
-                    } else {
-                        let o = self.owner[ui];
-                        if o != BLOCKED {
-                            let (a, b) = (gfind(&self.group, o), gfind(&self.group, s as u8));
-                            if a != b {
-                                self.group[a as usize] = b;
-                                event = true;
+                    let m = stamp[ui];
+                    if m < base {
+                        stamp[ui] = own;
+                        queue.push(u);
+                    } else if m != own && m != DEAD && m != base | BLOCKED {
+                        // Another search's triangle. Groups are kept flat (`group[s]` is
+                        // the root), so a meeting is one comparison; a merge relabels the
+                        // (at most 4) members.
+                        let (a, b) = (group[(m & 7) as usize], group[s]);
+                        if a != b {
+                            for g in group[..ns].iter_mut() {
+                                if *g == a {
+                                    *g = b;
+                                }
                             }
+                            event = true;
                         }
                     }
                 }
-                if self.head[s] == self.queue[s].len() {
+                if h + 1 == queue.len() {
                     event = true;
                 }
             }
@@ -574,14 +587,14 @@ impl<'a> State<'a> {
             let mut gsize = [0u32; 4];
             let mut gdone = [true; 4];
             for s in 0..ns {
-                let g = gfind(&self.group, s as u8) as usize;
+                let g = self.group[s] as usize;
                 gsize[g] += self.queue[s].len() as u32;
                 if self.head[s] < self.queue[s].len() {
                     gdone[g] = false;
                 }
             }
             for s in 0..ns {
-                if gfind(&self.group, s as u8) as usize == s {
+                if self.group[s] as usize == s {
                     groups += 1;
                     if !gdone[s] {
                         running += 1;
@@ -604,7 +617,7 @@ impl<'a> State<'a> {
                 let mut odd = 0;
                 let mut known = 0;
                 for s in 0..ns {
-                    if gfind(&self.group, s as u8) as usize == s && gdone[s] {
+                    if self.group[s] as usize == s && gdone[s] {
                         odd += gsize[s] & 1;
                         known += gsize[s];
                     }
@@ -613,10 +626,6 @@ impl<'a> State<'a> {
                     odd += (total - known) & 1;
                 } else {
                     debug_assert_eq!(known, total, "parts add up to the polder");
-                }
-                for s in 0..ns {
-                    let g = gfind(&self.group, s as u8);
-                    self.group[s] = g;
                 }
                 // Certificate: the finished parts whole; for the running part, the paths
                 // along which its searches met, or only its seeds when it is one search
@@ -927,6 +936,8 @@ impl<'a> State<'a> {
         // Remove the pair.
         self.alive[t0 as usize] = false;
         self.alive[t1 as usize] = false;
+        self.stamp[t0 as usize] = DEAD;
+        self.stamp[t1 as usize] = DEAD;
         self.remaining -= 2;
         self.chosen.push(c);
         let total = self.quality() + self.table.eta[ci];
@@ -977,12 +988,14 @@ impl<'a> State<'a> {
             }
         }
         for x in [t0, t1] {
-            for i in 0..self.watch[x as usize].len() {
-                let (c2, ver) = self.watch[x as usize][i];
+            // Marking touches no watch list: iterate the list taken out, then put it back.
+            let list = std::mem::take(&mut self.watch[x as usize]);
+            for &(c2, ver) in &list {
                 if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
                     self.mark(c2);
                 }
             }
+            self.watch[x as usize] = list;
         }
         if !self.changed.is_empty() {
             for i in 0..self.split.len() {
@@ -1006,6 +1019,7 @@ impl<'a> State<'a> {
                     let [t0, t1] = self.table.pairs[c as usize];
                     for x in [t0, t1] {
                         self.alive[x as usize] = true;
+                        self.stamp[x as usize] = 0;
                         for v in self.mesh.triangles[x as usize] {
                             self.dead_count[v as usize] -= 1;
                         }
