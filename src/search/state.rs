@@ -23,7 +23,7 @@
 //!   applying an action rechecks only: the candidates at vertices whose fan just lost its
 //!   first triangle, the verdicts watching the two removed triangles, and, when a polder
 //!   changes parity (only an odd polder can split into parts of other parity), the split
-//!   verdicts in the parts that changed. Proof sketch in `docs/readme/search.md`.
+//!   verdicts in the parts that changed. Proof sketch in `docs/search.md`.
 //! * Polder ids and sizes are kept per triangle; a split relabels only the finished
 //!   (smaller) parts the search already enumerated.
 //! * `P_k` buckets are arrays with position indices (O(1) move, uniform pick), restored to
@@ -802,7 +802,7 @@ impl<'a> State<'a> {
     }
 
     /// Makes every verdict exact.
-    pub(crate) fn resolve_all(&mut self) {
+    pub fn resolve_all(&mut self) {
         while let Some(c) = self.dirty_list.pop() {
             self.log.push(Op::DirtyPop(c));
             if self.dirty[c as usize] {
@@ -819,14 +819,14 @@ impl<'a> State<'a> {
 
     /// Exact allowed-ness inside a lazy tree (rechecks `c` first if needed).
     #[inline]
-    pub(crate) fn is_allowed_lazy(&mut self, c: u32) -> bool {
+    pub fn is_allowed_lazy(&mut self, c: u32) -> bool {
         self.resolve(c);
         self.allowed[c as usize]
     }
 
     /// Exact number of allowed actions of `t` inside a lazy tree.
     #[inline]
-    pub(crate) fn allowed_count_lazy(&mut self, t: u32) -> u32 {
+    pub fn allowed_count_lazy(&mut self, t: u32) -> u32 {
         if self.alive[t as usize] {
             for c in self.table.by_triangle[t as usize] {
                 if c != NONE {
@@ -849,7 +849,7 @@ impl<'a> State<'a> {
 
     /// Like [`State::apply`], but the verdicts the action may have changed are only marked;
     /// the lazy queries (and `resolve_all`) recheck them when asked. For the trees.
-    pub(crate) fn apply_lazy(&mut self, c: u32) {
+    pub fn apply_lazy(&mut self, c: u32) {
         let ci = c as usize;
         let [t0, t1] = self.table.pairs[ci];
         assert!(

@@ -405,11 +405,19 @@ fn optimum_of_text_dump() {
 fn cli_writes_the_optimal_quad_mesh() {
     let dir = tempfile::tempdir().unwrap();
     let out = crate::util::run_in(dir.path(), &["optimum", "sphere", "-o", "opt.msh"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let path = dir.path().join("opt.msh");
     let file = quadrecomb::mesh::msh::parse(&path, &std::fs::read(&path).unwrap()).unwrap();
     // All 2,104 triangles of the built-in sphere pair up: 1,052 quads, no triangle left.
-    assert_eq!((file.data.quads.len(), file.data.triangles.len()), (1052, 0), "read back");
+    assert_eq!(
+        (file.data.quads.len(), file.data.triangles.len()),
+        (1052, 0),
+        "read back"
+    );
     let bad = crate::util::run_in(dir.path(), &["optimum", "sphere", "-o", "opt.txt"]);
     assert_eq!(bad.status.code(), Some(2));
 }

@@ -1,10 +1,6 @@
 //! The state's lazy mode (as the trees use it: `apply_lazy` marks verdicts that may have
 //! changed, queries recheck what they touch, `resolve_all` makes everything exact) against the
 //! naive oracle: partial queries after every lazy apply and undo, full comparison at decisions.
-//!
-//! NOT COMPILED YET: `apply_lazy`, `is_allowed_lazy`, `allowed_count_lazy` and `resolve_all`
-//! are `pub(crate)` (search 1a46f9d). Make them `pub` and add `mod lazy;` to
-//! `search_oracle.rs` to switch this test on (it passed with them made public locally).
 
 use super::meshes::{self, Diagonals, Grid};
 use super::naive::Naive;
