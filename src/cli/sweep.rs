@@ -50,6 +50,9 @@ pub struct Args {
     /// Continue the sweep in --out, skipping the runs it already recorded.
     #[arg(long)]
     resume: bool,
+    /// Replace the results of an earlier sweep in --out (runs, summary, report, figures).
+    #[arg(long, conflicts_with = "resume")]
+    overwrite: bool,
     /// Run only the I-th of N disjoint slices of the run list (1 <= I <= N).
     #[arg(long, value_name = "I/N")]
     shard: Option<Shard>,
@@ -127,6 +130,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         backend: args.backend,
         out: out.clone(),
         resume: args.resume,
+        overwrite: args.overwrite,
         shard: args.shard,
         progress: if args.quiet {
             ProgressMode::Quiet

@@ -23,6 +23,9 @@ pub struct EngineOptions {
     pub dir: PathBuf,
     /// Continue a sweep already in `dir`.
     pub resume: bool,
+    /// Replace the results of an earlier sweep in `dir` (ignored with `resume`): its runs,
+    /// manifest, summary, report and figures are removed first; the optimum cache is kept.
+    pub overwrite: bool,
     /// Worker threads.
     pub threads: usize,
     /// Progress display.
@@ -128,6 +131,31 @@ pub(crate) fn check_records(
     Ok(seen)
 }
 
+/// Removes what an earlier sweep wrote into `dir` (runs, manifest, summary, report, figures).
+fn clear_results(dir: &Path) -> Result<(), ExperimentError> {
+    for name in [
+        RUNS_FILE,
+        MANIFEST_FILE,
+        "summary.csv",
+        "summary.json",
+        "report.md",
+        "report.html",
+    ] {
+        match std::fs::remove_file(dir.join(name)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(ExperimentError::io(&dir.join(name), e));
+            }
+            _ => {}
+        }
+    }
+    match std::fs::remove_dir_all(dir.join("figures")) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(ExperimentError::io(&dir.join("figures"), e))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Runs the sweep described by `manifest` (its spec and shard) into `opts.dir`.
 ///
 /// A fresh directory must not hold runs yet; with `resume`, its manifest must describe the
@@ -143,6 +171,9 @@ pub fn run(
     let dir = &opts.dir;
     std::fs::create_dir_all(dir).map_err(|e| ExperimentError::io(dir, e))?;
     let _lock = super::lock::DirLock::acquire(dir)?;
+    if opts.overwrite && !opts.resume {
+        clear_results(dir)?;
+    }
     let runs_path = dir.join(RUNS_FILE);
     let loaded = store::read(&runs_path)?;
     if dir.join(MANIFEST_FILE).exists() {
@@ -257,6 +288,7 @@ pub(crate) mod tests {
         EngineOptions {
             dir: dir.to_path_buf(),
             resume,
+            overwrite: false,
             threads,
             progress: ProgressMode::Quiet,
         }

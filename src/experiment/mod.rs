@@ -52,7 +52,7 @@ pub enum ExperimentError {
     },
     /// The output directory already holds runs and `--resume` was not given.
     #[error(
-        "{dir}: already holds {records} run(s); pass --resume to continue that sweep, or choose another --out"
+        "{dir}: already holds {records} run(s); pass --resume to continue that sweep, --overwrite to replace it, or choose another --out"
     )]
     AlreadyExists {
         /// The directory.

@@ -48,6 +48,8 @@ pub struct SweepConfig {
     pub out: PathBuf,
     /// Continue the sweep in `out`.
     pub resume: bool,
+    /// Replace an earlier sweep's results in `out`.
+    pub overwrite: bool,
     /// Run only this slice of the run list.
     pub shard: Option<Shard>,
     /// Progress display.
@@ -68,6 +70,7 @@ impl SweepConfig {
             backend: Backend::Auto,
             out: PathBuf::from("results/borouchaki"),
             resume: false,
+            overwrite: false,
             shard: None,
             progress: ProgressMode::Auto,
         }
@@ -337,6 +340,7 @@ pub fn run(
         &EngineOptions {
             dir: config.out.clone(),
             resume: config.resume,
+            overwrite: config.overwrite,
             threads: config.threads,
             progress: config.progress,
         },

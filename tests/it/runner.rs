@@ -254,6 +254,46 @@ fn torn_last_line_is_redone_on_resume_and_fresh_sweep_refuses_a_used_dir() {
 }
 
 #[test]
+fn overwrite_replaces_an_earlier_sweep_with_another_configuration() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    assert!(
+        sweep(dir, &sweep_args(&mesh, "out", 4, "1..3"), &[])
+            .status
+            .success()
+    );
+    let figure = dir.join("out/figures/stale.svg");
+    std::fs::create_dir_all(figure.parent().unwrap()).unwrap();
+    std::fs::write(&figure, "<svg/>").unwrap();
+    let args = sweep_args(&mesh, "out", 3, "1..2");
+    let refused = sweep(dir, &args, &[]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(
+        stderr(&refused).contains("--overwrite"),
+        "{}",
+        stderr(&refused)
+    );
+
+    let replaced = sweep(dir, &args, &["--overwrite"]);
+    assert!(replaced.status.success(), "{}", stderr(&replaced));
+    assert!(!figure.exists(), "old figures are removed");
+    let fresh = sweep(dir, &sweep_args(&mesh, "fresh", 3, "1..2"), &[]);
+    assert!(fresh.status.success());
+    assert_same(
+        &records(&dir.join("fresh")),
+        &records(&dir.join("out")),
+        "overwritten vs fresh",
+    );
+    let both = sweep(dir, &args, &["--overwrite", "--resume"]);
+    assert_eq!(
+        both.status.code(),
+        Some(2),
+        "--overwrite conflicts with --resume"
+    );
+}
+
+#[test]
 fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
