@@ -114,7 +114,63 @@ struct Buffers {
     eta: wgpu::Buffer,
     read: wgpu::Buffer,
     bind: wgpu::BindGroup,
-    queries: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer)>,
+    queries: Option<Timestamps>,
+}
+
+/// Two device timestamps around compute passes: the query set, and the buffers its values are
+/// resolved into and read back from.
+#[derive(Debug)]
+struct Timestamps {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    read: wgpu::Buffer,
+}
+
+impl Timestamps {
+    /// `None` when the adapter cannot write timestamps.
+    fn new(device: &wgpu::Device, label: &str) -> Option<Timestamps> {
+        if !device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
+            return None;
+        }
+        let buffer = |usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 16,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Some(Timestamps {
+            set: device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some(label),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            }),
+            resolve: buffer(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
+            read: buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
+        })
+    }
+
+    /// Writes for a pass: timestamp 0 at its beginning and/or 1 at its end.
+    fn writes(&self, begin: Option<u32>, end: Option<u32>) -> wgpu::ComputePassTimestampWrites<'_> {
+        wgpu::ComputePassTimestampWrites {
+            query_set: &self.set,
+            beginning_of_pass_write_index: begin,
+            end_of_pass_write_index: end,
+        }
+    }
+
+    /// Records the copy of both timestamps to the readback buffer.
+    fn resolve(&self, enc: &mut wgpu::CommandEncoder) {
+        enc.resolve_query_set(&self.set, 0..2, &self.resolve, 0);
+        enc.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, 16);
+    }
+
+    /// Seconds between the two timestamps, once the work has been submitted.
+    fn seconds(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<f64, GpuError> {
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&read_back(device, &self.read, 16)?);
+        Ok(ticks[1].wrapping_sub(ticks[0]) as f64 * queue.get_timestamp_period() as f64 * 1e-9)
+    }
 }
 
 fn entry(binding: u32, buf: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
@@ -168,16 +224,9 @@ impl Buffers {
                 Layout::Local => vec![entry(0, &params), entry(3, &eta), entry(4, &quads)],
             },
         });
-        let queries = timestamps.then(|| {
-            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("kernel time"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2,
-            });
-            let resolve = buffer("timestamps", 16, U::QUERY_RESOLVE | U::COPY_SRC);
-            let read = buffer("timestamps readback", 16, U::MAP_READ | U::COPY_DST);
-            (set, resolve, read)
-        });
+        let queries = timestamps
+            .then(|| Timestamps::new(device, "kernel time"))
+            .flatten();
         Buffers {
             vertex_cap,
             chunk,
@@ -380,7 +429,6 @@ impl Kernel {
             &bufs.bind,
         );
         let queries = bufs.queries.as_ref();
-        let period_ns = queue.get_timestamp_period() as f64;
 
         let mut out = Vec::with_capacity(n);
         let mut remap = if whole {
@@ -449,28 +497,22 @@ impl Kernel {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("quad_quality"),
-                    timestamp_writes: queries.map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
-                        query_set: set,
-                        beginning_of_pass_write_index: Some(0),
-                        end_of_pass_write_index: Some(1),
-                    }),
+                    timestamp_writes: queries.map(|q| q.writes(Some(0), Some(1))),
                 });
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, bind, &[]);
                 pass.dispatch_workgroups(gx as u32, gy as u32, 1);
             }
-            if let Some((set, resolve, read)) = queries {
-                enc.resolve_query_set(set, 0..2, resolve, 0);
-                enc.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
+            if let Some(q) = queries {
+                q.resolve(&mut enc);
             }
             checked(device, "running the quality kernel", || {
                 queue.submit([enc.finish()])
             })?;
             wait(device)?;
             timings.kernel_s += t.elapsed().as_secs_f64();
-            if let Some((_, _, read)) = queries {
-                let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&read_back(device, read, 16)?);
-                device_s += ticks[1].wrapping_sub(ticks[0]) as f64 * period_ns * 1e-9;
+            if let Some(q) = queries {
+                device_s += q.seconds(device, queue)?;
             }
 
             // Readback.
@@ -511,57 +553,32 @@ pub fn copy_bandwidth(
         };
         (mk("bandwidth src"), mk("bandwidth dst"))
     })?;
-    let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
     let mut best = f64::INFINITY;
     for _ in 0..5 {
         let t = Instant::now();
         let mut enc = device.create_command_encoder(&Default::default());
-        let queries = timestamps.then(|| {
-            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: None,
-                ty: wgpu::QueryType::Timestamp,
-                count: 2,
-            });
-            let mk = |usage| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: None,
-                    size: 16,
-                    usage,
-                    mapped_at_creation: false,
-                })
-            };
-            let resolve = mk(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
-            let read = mk(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
-            (set, resolve, read)
-        });
+        let queries = Timestamps::new(device, "copy time");
         // Timestamps around the copy from two empty compute passes (writing timestamps
         // inside an encoder needs a feature few adapters have).
         let mark = |enc: &mut wgpu::CommandEncoder, i: u32| {
-            if let Some((set, _, _)) = &queries {
+            if let Some(q) = &queries {
                 enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: None,
-                    timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
-                        query_set: set,
-                        beginning_of_pass_write_index: Some(i),
-                        end_of_pass_write_index: None,
-                    }),
+                    timestamp_writes: Some(q.writes(Some(i), None)),
                 });
             }
         };
         mark(&mut enc, 0);
         enc.copy_buffer_to_buffer(&src, 0, &dst, 0, bytes);
         mark(&mut enc, 1);
-        if let Some((set, resolve, read)) = &queries {
-            enc.resolve_query_set(set, 0..2, resolve, 0);
-            enc.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
+        if let Some(q) = &queries {
+            q.resolve(&mut enc);
         }
         queue.submit([enc.finish()]);
         wait(device)?;
         let mut s = t.elapsed().as_secs_f64();
-        if let Some((_, _, read)) = &queries {
-            let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&read_back(device, read, 16)?);
-            let d =
-                ticks[1].wrapping_sub(ticks[0]) as f64 * queue.get_timestamp_period() as f64 * 1e-9;
+        if let Some(q) = &queries {
+            let d = q.seconds(device, queue)?;
             if d > 0.0 {
                 s = d;
             }
@@ -634,57 +651,30 @@ pub fn stream_bandwidth(
             },
         ],
     });
-    let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
     let mut best = f64::INFINITY;
     for _ in 0..5 {
-        let queries = timestamps.then(|| {
-            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: None,
-                ty: wgpu::QueryType::Timestamp,
-                count: 2,
-            });
-            let mk = |usage| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: None,
-                    size: 16,
-                    usage,
-                    mapped_at_creation: false,
-                })
-            };
-            let resolve = mk(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
-            let read = mk(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
-            (set, resolve, read)
-        });
+        let queries = Timestamps::new(device, "stream copy time");
         let t = Instant::now();
         let mut enc = device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("stream_copy"),
-                timestamp_writes: queries.as_ref().map(|(set, _, _)| {
-                    wgpu::ComputePassTimestampWrites {
-                        query_set: set,
-                        beginning_of_pass_write_index: Some(0),
-                        end_of_pass_write_index: Some(1),
-                    }
-                }),
+                timestamp_writes: queries.as_ref().map(|q| q.writes(Some(0), Some(1))),
             });
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &bind, &[]);
             pass.dispatch_workgroups(gx as u32, gy as u32, 1);
         }
-        if let Some((set, resolve, read)) = &queries {
-            enc.resolve_query_set(set, 0..2, resolve, 0);
-            enc.copy_buffer_to_buffer(resolve, 0, read, 0, 16);
+        if let Some(q) = &queries {
+            q.resolve(&mut enc);
         }
         checked(device, "running the stream-copy kernel", || {
             queue.submit([enc.finish()])
         })?;
         wait(device)?;
         let mut s = t.elapsed().as_secs_f64();
-        if let Some((_, _, read)) = &queries {
-            let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&read_back(device, read, 16)?);
-            let d =
-                ticks[1].wrapping_sub(ticks[0]) as f64 * queue.get_timestamp_period() as f64 * 1e-9;
+        if let Some(q) = &queries {
+            let d = q.seconds(device, queue)?;
             if d > 0.0 {
                 s = d;
             }
