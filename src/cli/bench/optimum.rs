@@ -1,7 +1,9 @@
 //! `quadrecomb bench optimum`: time of the exact optimum on the built-in meshes and on
 //! generated jittered grids of growing size, with the fitted growth exponent and peak memory.
 
+use quadrecomb::mesh::generate::{self, GridSpec};
 use quadrecomb::mesh::{Mesh, MeshData};
+use quadrecomb::stats::describe::linear_fit;
 use quadrecomb::quality::CandidateTable;
 use quadrecomb::search::optimum;
 use rand::{RngExt, SeedableRng};
@@ -175,50 +177,17 @@ fn peak_rss() -> Option<u64> {
 fn slope(points: &[(f64, f64)]) -> f64 {
     let xs: Vec<f64> = points.iter().map(|p| p.0.ln()).collect();
     let ys: Vec<f64> = points.iter().map(|p| p.1.ln()).collect();
-    let k = xs.len() as f64;
-    let (mx, my) = (xs.iter().sum::<f64>() / k, ys.iter().sum::<f64>() / k);
-    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
-    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
-    sxy / sxx
+    linear_fit(&xs, &ys).map_or(f64::NAN, |fit| fit.slope)
 }
 
-/// A jittered square grid of about `n` triangles (each square split along a random
-/// diagonal), seeded, so that every run times the same mesh.
-pub fn grid(n: usize, seed: u64) -> Mesh {
-    let squares = (n / 2).max(1);
-    let nx = ((squares as f64).sqrt().round() as usize).max(1);
-    let ny = squares.div_ceil(nx);
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut vertices = Vec::with_capacity((nx + 1) * (ny + 1));
-    for j in 0..=ny {
-        for i in 0..=nx {
-            let interior = i > 0 && i < nx && j > 0 && j < ny;
-            let (dx, dy) = if interior {
-                (rng.random_range(-0.2..0.2), rng.random_range(-0.2..0.2))
-            } else {
-                (0.0, 0.0)
-            };
-            vertices.push([i as f64 + dx, j as f64 + dy, 0.0]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let mut triangles = Vec::with_capacity(2 * nx * ny);
-    for j in 0..ny {
-        for i in 0..nx {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            if rng.random_bool(0.5) {
-                triangles.extend([[a, b, c], [a, c, d]]);
-            } else {
-                triangles.extend([[a, b, d], [b, c, d]]);
-            }
-        }
-    }
-    Mesh::new(MeshData {
-        vertices,
-        triangles,
-        ..MeshData::default()
+/// The seeded jittered right-triangle grid of about `n` triangles (`generate grid`), so that
+/// every run times the same mesh.
+fn grid(n: usize, seed: u64) -> Mesh {
+    generate::grid(GridSpec {
+        triangles: n,
+        seed,
+        ..GridSpec::default()
     })
-    .expect("a jittered grid is a valid mesh")
 }
 
 /// A jittered equilateral triangle lattice of about `n` triangles (rows offset by half a
