@@ -3,9 +3,9 @@
 
 use quadrecomb::mesh::generate::{self, GridSpec};
 use quadrecomb::mesh::{Mesh, MeshData};
-use quadrecomb::stats::describe::linear_fit;
 use quadrecomb::quality::CandidateTable;
 use quadrecomb::search::optimum;
+use quadrecomb::stats::describe::linear_fit;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::process::{Command, ExitCode};
