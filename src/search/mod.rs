@@ -150,7 +150,6 @@ pub struct Searcher<'a> {
     cursor: usize,
     rng: ChaCha8Rng,
     nodes: u64,
-    path: Vec<u32>,
     near: Vec<u32>,
     used: Vec<bool>,
 }
@@ -176,7 +175,6 @@ impl<'a> Searcher<'a> {
             cursor: 0,
             rng: ChaCha8Rng::seed_from_u64(0),
             nodes: 0,
-            path: Vec::new(),
             near: Vec::new(),
             used: vec![false; mesh.num_triangles()],
         }

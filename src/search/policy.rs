@@ -4,6 +4,13 @@
 use super::Searcher;
 use crate::mesh::NONE;
 use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+/// Uniform pick in `0..n` (n > 0) from a ChaCha8 stream: the top 64 bits of `u64 * n`,
+/// portable and the same on every platform.
+fn pick_from(rng: &mut ChaCha8Rng, n: usize) -> usize {
+    ((rng.next_u64() as u128 * n as u128) >> 64) as usize
+}
 
 /// Slack added to branch-and-bound upper bounds so that rounding never prunes a sequence
 /// whose value could tie or beat the best (keeps the result identical to exhaustive search).
@@ -12,7 +19,7 @@ const BOUND_SLACK: f64 = 1e-9;
 impl Searcher<'_> {
     /// Uniform pick in `0..n` (n > 0) from the run's ChaCha8 stream, portable.
     fn pick(&mut self, n: usize) -> usize {
-        ((self.rng.next_u64() as u128 * n as u128) >> 64) as usize
+        pick_from(&mut self.rng, n)
     }
 
     /// Moves the cursor past candidates that are no longer live (permanent on the main
@@ -94,11 +101,12 @@ impl Searcher<'_> {
             let top = self.state.table().eta[self.order[self.cursor] as usize];
             let mut best = f64::NEG_INFINITY;
             let mut first = NONE;
+            self.state.tree_begin();
             self.uniform_dfs(0, h, 0.0, top, NONE, &mut best, &mut first);
             if first == NONE {
                 break;
             }
-            self.state.apply_lazy(first);
+            self.state.apply(first);
         }
     }
 
@@ -124,7 +132,7 @@ impl Searcher<'_> {
         while i < self.order.len() {
             let c = self.order[i];
             i += 1;
-            if !self.state.is_allowed_lazy(c) {
+            if !self.state.tree_allowed(c) {
                 continue;
             }
             any = true;
@@ -144,9 +152,9 @@ impl Searcher<'_> {
                     *first = r;
                 }
             } else {
-                self.state.apply_lazy(c);
+                self.state.tree_push(c);
                 self.uniform_dfs(d + 1, h, partial + eta, top, r, best, first);
-                self.state.undo();
+                self.state.tree_pop();
             }
         }
         if !any && d > 0 && partial > *best {
@@ -160,10 +168,11 @@ impl Searcher<'_> {
     pub(super) fn selective(&mut self, h: u32) {
         let table = self.state.table();
         while let Some(k) = self.state.min_k() {
-            let n = self.state.bucket(k).len();
+            let n = self.state.bucket_len(k);
             let i = self.pick(n);
-            let t = self.state.bucket(k)[i];
+            let t = self.state.bucket_nth(k, i);
             self.nodes += 1;
+            self.state.tree_begin();
             let mut best = f64::NEG_INFINITY;
             let mut first = NONE;
             for c in table.by_triangle[t as usize] {
@@ -187,11 +196,9 @@ impl Searcher<'_> {
         if d == h {
             return 0.0;
         }
-        self.state.apply_lazy(c);
-        self.path.push(c);
+        self.state.tree_push(c);
         let v = self.selective_node(d, h);
-        self.path.pop();
-        self.state.undo();
+        self.state.tree_pop();
         v
     }
 
@@ -204,7 +211,7 @@ impl Searcher<'_> {
         self.nodes += 1;
         let mut best = f64::NEG_INFINITY;
         for c in table.by_triangle[t as usize] {
-            if c == NONE || !self.state.is_allowed_lazy(c) {
+            if c == NONE || !self.state.tree_allowed(c) {
                 continue;
             }
             let v = table.eta[c as usize] + self.selective_child(c, d + 1, h);
@@ -216,36 +223,28 @@ impl Searcher<'_> {
     }
 
     /// The triangle to branch on below the root: uniformly from the first non-empty
-    /// `P_k ∩ N` (N: recombinable triangles next to a quad of the path), else from `P_min`.
+    /// `P_k ∩ N` (N: recombinable triangles across an edge of a quad of the path, in path
+    /// then side order), else from `P_min` (in increasing id).
     fn choose_triangle(&mut self) -> Option<u32> {
         self.near.clear();
-        let mut kmin = u32::MAX;
-        for i in 0..self.path.len() {
-            for n in self.state.quad_neighbours(self.path[i]) {
-                if n == NONE {
-                    continue;
-                }
-                let k = self.state.allowed_count_lazy(n);
-                if k == 0 || k > kmin {
-                    continue;
-                }
-                if k < kmin {
-                    kmin = k;
-                    self.near.clear();
-                }
-                if !self.near.contains(&n) {
-                    self.near.push(n);
-                }
+        let mut kmin = u8::MAX;
+        for &(n, k, _) in self.state.tree_near() {
+            if n == NONE || k == 0 || k > kmin {
+                continue;
+            }
+            if k < kmin {
+                kmin = k;
+                self.near.clear();
+            }
+            if !self.near.contains(&n) {
+                self.near.push(n);
             }
         }
         if !self.near.is_empty() {
             let i = self.pick(self.near.len());
             return Some(self.near[i]);
         }
-        self.state.resolve_all();
-        let k = self.state.min_k()?;
-        let n = self.state.bucket(k).len();
-        let i = self.pick(n);
-        Some(self.state.bucket(k)[i])
+        let rng = &mut self.rng;
+        self.state.tree_pick_pmin(|n| pick_from(rng, n))
     }
 }

@@ -8,7 +8,9 @@
 mod lazy;
 mod meshes;
 mod naive;
+mod selective;
 mod state;
+mod tree;
 mod walk;
 
 use meshes::{Diagonals, Grid, Surfaces};

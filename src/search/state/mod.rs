@@ -26,13 +26,26 @@
 //!   verdicts in the parts that changed. Proof sketch in `docs/search.md`.
 //! * Polder ids and sizes are kept per triangle; a split relabels only the finished
 //!   (smaller) parts the search already enumerated.
-//! * `P_k` buckets are arrays with position indices (O(1) move, uniform pick), restored to
-//!   the same order by `undo`, so runs are reproducible whatever the tree explored.
+//! * `P_k` are kept as counting Fenwick trees over triangle ids (`pk`): a uniform draw takes
+//!   the i-th member in increasing id order, so it depends on the current state only.
+//! * **Look-ahead trees** (`tree`) explore on top of this exact base state without
+//!   maintaining it: `tree_push` / `tree_pop` change only what the criterion reads (remaining
+//!   triangles, fans, dead components, polders), and a verdict asked for inside the tree is
+//!   taken from the base or from the tree's own cache when it *still holds* (its clean
+//!   vertices still clean, its certificate intact: checked on reading, nothing is marked),
+//!   else recomputed. `P_min` inside the tree (rare) is the base sets corrected by the
+//!   triangles the path can have changed.
 
 #![allow(clippy::needless_range_loop)] // index loops over the 4 quad sides read best
 
+mod check;
+mod pk;
+mod tree;
+
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
+use pk::OrderedSets;
+use tree::Overlay;
 
 /// How a verdict was reached (what it depends on).
 const KIND_LOCAL: u8 = 0;
@@ -43,6 +56,8 @@ const KIND_SPLIT: u8 = 2;
 /// The quad touches removed regions in several places, all in distinct dead components:
 /// one part. Depends on those components staying distinct.
 const KIND_DISTINCT: u8 = 3;
+/// `cand_flags` bit: one triangle neighbours the quad across two of its sides.
+const FLAG_SHARED_NEIGHBOUR: u8 = 1 << 4;
 /// Owner mark for the two triangles being removed during a search.
 const BLOCKED: u32 = 7;
 /// Search mark of a used triangle: above every epoch's marks, so one comparison tells an
@@ -56,15 +71,12 @@ const EPOCH_LIMIT: u32 = (1 << 29) - 2;
 enum Op {
     /// Start of an `apply(c)`: undone last, revives the pair.
     Apply(u32),
-    /// Previous verdict of a candidate.
-    Verdict {
-        c: u32,
-        ver: u32,
-        allowed: bool,
-        kind: u8,
-    },
-    /// Triangle `t` had `old` allowed actions, at position `pos` of bucket `old`.
-    Count { t: u32, old: u8, pos: u32 },
+    /// Start of a `tree_push(c)`: undone last by `tree_pop`, revives the pair.
+    TreeApply(u32),
+    /// Previous verdict of candidate `c`.
+    Verdict { c: u32, old: Verdict },
+    /// Triangle `t` had `old` allowed actions.
+    Count { t: u32, old: u8 },
     /// Triangle `t` was in polder `old`.
     Polder { t: u32, old: u32 },
     /// A polder id was created.
@@ -89,11 +101,25 @@ enum Op {
     DirtyPop(u32),
 }
 
-/// Result of one criterion check, with the parts the search enumerated left in scratch.
-#[derive(Debug, Clone, Copy)]
-struct Check {
+/// A verdict of the criterion and what it depends on.
+#[derive(Debug, Clone, Copy, Default)]
+struct Verdict {
     allowed: bool,
+    /// `KIND_*`: how it was reached.
     kind: u8,
+    /// Bit i: quad vertex i was clean (closed fan, no used triangle) when it was computed;
+    /// the verdict holds only while these stay clean.
+    mask: u8,
+    /// Split: odd parts among the finished (enumerated) parts.
+    fin_odd: u8,
+    /// Split: triangles in the finished parts.
+    fin_known: u32,
+    /// Certificate in its arena (`offset`, `length`): dead-component roots for
+    /// `KIND_DISTINCT`, triangles for `KIND_MET` / `KIND_SPLIT`.
+    cert: u32,
+    cert_len: u32,
+    /// Version the watch lists refer to (base verdicts).
+    ver: u32,
 }
 
 /// The recombination state. See the module docs.
@@ -106,6 +132,8 @@ pub struct State<'a> {
     cand_nb: Vec<[u32; 4]>,
     /// Vertex fan is one closed cycle of triangles in the dual graph.
     closed: Vec<bool>,
+    /// Per candidate: bit i set when quad vertex i has a closed fan; `FLAG_SHARED_NEIGHBOUR`.
+    cand_flags: Vec<u8>,
     /// Candidates whose quad has vertex `v` (CSR).
     vc_start: Vec<u32>,
     vc_list: Vec<u32>,
@@ -113,11 +141,12 @@ pub struct State<'a> {
     alive: Vec<bool>,
     remaining: u32,
     count: Vec<u8>,
-    bucket: [Vec<u32>; 4],
-    pos: Vec<u32>,
-    allowed: Vec<bool>,
-    kind: Vec<u8>,
-    cert_ver: Vec<u32>,
+    sets: OrderedSets,
+    verdict: Vec<Verdict>,
+    /// Certificates of the base verdicts (append-only; cut back to the initial verdicts'
+    /// when the state is reset).
+    base_cert: Vec<u32>,
+    base_cert_init: usize,
     ver: u32,
     dead_count: Vec<u32>,
     polder: Vec<u32>,
@@ -139,6 +168,8 @@ pub struct State<'a> {
     chosen: Vec<u32>,
     quality: Vec<f64>,
     log: Vec<Op>,
+    /// The look-ahead tree on top of the base state.
+    tree: Overlay,
     // ---- scratch ----
     /// Search marks: `epoch << 3 | owner` (owner = search index or `BLOCKED`) for a triangle
     /// visited by the current search, lower for an unvisited one, `DEAD` for a used one.
@@ -249,21 +280,53 @@ impl<'a> State<'a> {
                 fill[v as usize] += 1;
             }
         }
+        let cand_flags: Vec<u8> = (0..m)
+            .map(|c| {
+                let (q, n) = (table.quads[c], cand_nb[c]);
+                let mut f = 0u8;
+                for i in 0..4 {
+                    if closed[q[i] as usize] {
+                        f |= 1 << i;
+                    }
+                    if n[i] != NONE && (0..i).any(|j| n[j] == n[i]) {
+                        f |= FLAG_SHARED_NEIGHBOUR;
+                    }
+                }
+                f
+            })
+            .collect();
+        let ring: Vec<[u32; 6]> = (0..nt)
+            .map(|t| {
+                let tri = mesh.triangles[t];
+                let mut r = [tri[0], tri[1], tri[2], NONE, NONE, NONE];
+                for i in 0..3 {
+                    let u = nb[t][i];
+                    if u != NONE {
+                        let (a, b) = (tri[i], tri[(i + 1) % 3]);
+                        r[3 + i] = mesh.triangles[u as usize]
+                            .into_iter()
+                            .find(|&x| x != a && x != b)
+                            .unwrap_or(NONE);
+                    }
+                }
+                r
+            })
+            .collect();
         let mut st = State {
             mesh,
             table,
             cand_nb,
             closed,
+            cand_flags,
             vc_start,
             vc_list,
             alive: vec![true; nt],
             remaining: nt as u32,
             count: vec![0; nt],
-            bucket: Default::default(),
-            pos: vec![NONE; nt],
-            allowed: vec![false; m],
-            kind: vec![KIND_LOCAL; m],
-            cert_ver: vec![0; m],
+            sets: OrderedSets::new(nt),
+            verdict: vec![Verdict::default(); m],
+            base_cert: Vec::new(),
+            base_cert_init: 0,
             ver: 0,
             dead_count: vec![0; nv],
             polder: mesh.topology.component.clone(),
@@ -281,6 +344,7 @@ impl<'a> State<'a> {
             chosen: Vec::new(),
             quality: vec![0.0],
             log: Vec::new(),
+            tree: Overlay::new(m, nv, ring),
             stamp: vec![0; nt],
             epoch: 0,
             queue: Default::default(),
@@ -313,6 +377,7 @@ impl<'a> State<'a> {
         }
         // The initial verdicts are the base state: nothing to undo before it.
         st.log.clear();
+        st.base_cert_init = st.base_cert.len();
         st
     }
 
@@ -330,7 +395,7 @@ impl<'a> State<'a> {
     /// allows it. Exact at any time.
     #[inline]
     pub fn is_allowed(&self, c: u32) -> bool {
-        self.allowed[c as usize]
+        self.verdict[c as usize].allowed
     }
 
     /// Number of allowed actions of triangle `t` (the `k` of `P_k`); 0 for a used triangle.
@@ -355,22 +420,35 @@ impl<'a> State<'a> {
     /// Every allowed action, in increasing candidate order (O(candidates); for tests).
     pub fn allowed_actions(&self) -> Vec<u32> {
         (0..self.table.len() as u32)
-            .filter(|&c| self.allowed[c as usize])
+            .filter(|&c| self.verdict[c as usize].allowed)
             .collect()
     }
 
-    /// Triangles with exactly `k` allowed actions (`P_k`, k in 1..=3), in bucket order.
+    /// Triangles with exactly `k` allowed actions (`P_k`, k in 1..=3), in increasing id
+    /// (O(|P_k| log n); for tests).
+    pub fn bucket(&self, k: u32) -> Vec<u32> {
+        (0..self.bucket_len(k))
+            .map(|i| self.bucket_nth(k, i))
+            .collect()
+    }
+
+    /// Size of `P_k` (k in 1..=3).
     #[inline]
-    pub fn bucket(&self, k: u32) -> &[u32] {
-        &self.bucket[k as usize]
+    pub fn bucket_len(&self, k: u32) -> usize {
+        self.sets.len(k as usize)
+    }
+
+    /// The member of `P_k` with `i` members of smaller id (`i < bucket_len(k)`): a uniform
+    /// draw from `P_k` is `bucket_nth(k, uniform(0..len))`. O(log n).
+    #[inline]
+    pub fn bucket_nth(&self, k: u32, i: usize) -> u32 {
+        self.sets.select(k as usize, i)
     }
 
     /// The smallest `k` with `P_k` non-empty, or `None` when no action is allowed.
     #[inline]
     pub fn min_k(&self) -> Option<u32> {
-        (1..4)
-            .find(|&k| !self.bucket[k].is_empty())
-            .map(|k| k as u32)
+        (1..4u32).find(|&k| self.bucket_len(k) > 0)
     }
 
     /// Candidates applied so far, in order.
@@ -414,294 +492,25 @@ impl<'a> State<'a> {
         self.chosen.len()
     }
 
-    // ------------------------------------------------------------------------------------
-    // The criterion.
-
-    /// Checks candidate `c` (both triangles remaining) in the current state. Leaves the
-    /// searches' visited triangles in `queue[..nsearch]` and their groups in `group`.
-    fn check(&mut self, c: u32) -> Check {
-        let [t0, t1] = self.table.pairs[c as usize];
-        let n = self.cand_nb[c as usize];
-        let q = self.table.quads[c as usize];
-        // Group label of each neighbour slot, kept flat: joining relabels the 4 slots.
-        let mut root = [0u8, 1, 2, 3];
-        #[inline(always)]
-        fn join(r: &mut [u8; 4], a: usize, b: usize) {
-            let (x, y) = (r[a], r[b]);
-            if x != y {
-                for k in r.iter_mut() {
-                    if *k == y {
-                        *k = x;
-                    }
-                }
-            }
-        }
-        let mut live = [false; 4];
-        for i in 0..4 {
-            live[i] = n[i] != NONE && self.alive[n[i] as usize];
-        }
-        for i in 0..4 {
-            if !live[i] {
-                continue;
-            }
-            for j in 0..i {
-                if live[j] && n[i] == n[j] {
-                    join(&mut root, i, j);
-                }
-            }
-            let j = (i + 1) % 4;
-            let v = q[j] as usize;
-            if live[j] && self.closed[v] && self.dead_count[v] == 0 {
-                join(&mut root, i, j);
-            }
-        }
-        // Distinct groups of live neighbours: one search per group.
-        let mut sid = [u8::MAX; 4];
-        let mut ns = 0usize;
-        for i in 0..4 {
-            if live[i] {
-                let r = root[i] as usize;
-                if sid[r] == u8::MAX {
-                    sid[r] = ns as u8;
-                    ns += 1;
-                }
-            }
-        }
-        self.nsearch = 0;
-        if ns <= 1 {
-            return Check {
-                allowed: true,
-                kind: KIND_LOCAL,
-            };
-        }
-        // Where the quad touches the removed region: arcs of touched vertices joined by
-        // touched edges. A split needs one dead component to touch the quad twice.
-        let mut touched = [false; 4];
-        for i in 0..4 {
-            let v = q[i] as usize;
-            touched[i] = !self.closed[v] || self.dead_count[v] > 0;
-        }
-        self.narcs = 0;
-        let mut distinct = true;
-        for i in 0..4 {
-            let prev = (i + 3) % 4;
-            // Edge `prev` joins q[prev] and q[i]; touched when its neighbour is gone.
-            if touched[i] && (live[prev] || !touched[prev]) {
-                let r = self.find(q[i]);
-                if self.arc_roots[..self.narcs].contains(&r) {
-                    distinct = false;
-                    break;
-                }
-                self.arc_roots[self.narcs] = r;
-                self.narcs += 1;
-            }
-        }
-        if distinct && self.narcs > 0 {
-            return Check {
-                allowed: true,
-                kind: KIND_DISTINCT,
-            };
-        }
-        self.searches += 1;
-        self.epoch += 1;
-        if self.epoch > EPOCH_LIMIT {
-            self.stamp.iter_mut().for_each(|s| {
-                if *s != DEAD {
-                    *s = 0;
-                }
-            });
-            self.epoch = 1;
-        }
-        let base = self.epoch << 3;
-        self.stamp[t0 as usize] = base | BLOCKED;
-        self.stamp[t1 as usize] = base | BLOCKED;
-        self.nsearch = ns;
-        for s in 0..ns {
-            self.queue[s].clear();
-            self.head[s] = 0;
-            self.group[s] = s as u8;
-        }
-        for i in 0..4 {
-            if live[i] {
-                let t = n[i] as usize;
-                if self.stamp[t] < base {
-                    let s = sid[root[i] as usize];
-                    self.stamp[t] = base | s as u32;
-                    self.queue[s as usize].push(t as u32);
-                }
-            }
-        }
-        for s in 0..ns {
-            self.nseed[s] = self.queue[s].len();
-        }
-        let nb = &self.mesh.topology.neighbours;
-        loop {
-            // The verdict can only change when a search runs dry or two groups meet.
-            let mut event = false;
-            for s in 0..ns {
-                // Disjoint field borrows: the hot loop reads no other state.
-                let queue = &mut self.queue[s];
-                let stamp = &mut self.stamp;
-                let group = &mut self.group;
-                let h = self.head[s];
-                if h == queue.len() {
-                    continue;
-                }
-                let x = queue[h];
-                self.head[s] = h + 1;
-                let own = base | s as u32;
-                for &u in &nb[x as usize] {
-                    if u == NONE {
-                        continue;
-                    }
-                    let ui = u as usize;
-                    let m = stamp[ui];
-                    if m < base {
-                        stamp[ui] = own;
-                        queue.push(u);
-                    } else if m != own && m != DEAD && m != base | BLOCKED {
-                        // Another search's triangle. Groups are kept flat (`group[s]` is
-                        // the root), so a meeting is one comparison; a merge relabels the
-                        // (at most 4) members.
-                        let (a, b) = (group[(m & 7) as usize], group[s]);
-                        if a != b {
-                            for g in group[..ns].iter_mut() {
-                                if *g == a {
-                                    *g = b;
-                                }
-                            }
-                            event = true;
-                        }
-                    }
-                }
-                if h + 1 == queue.len() {
-                    event = true;
-                }
-            }
-            if !event {
-                continue;
-            }
-            // Groups and how many are still running.
-            let mut groups = 0;
-            let mut running = 0;
-            let mut gsize = [0u32; 4];
-            let mut gdone = [true; 4];
-            for s in 0..ns {
-                let g = self.group[s] as usize;
-                gsize[g] += self.queue[s].len() as u32;
-                if self.head[s] < self.queue[s].len() {
-                    gdone[g] = false;
-                }
-            }
-            for s in 0..ns {
-                if self.group[s] as usize == s {
-                    groups += 1;
-                    if !gdone[s] {
-                        running += 1;
-                    }
-                }
-            }
-            if groups == 1 {
-                self.count_searched(ns);
-                for s in 0..ns {
-                    self.cert_len[s] = self.queue[s].len();
-                }
-                return Check {
-                    allowed: true,
-                    kind: KIND_MET,
-                };
-            }
-            if running <= 1 {
-                self.count_searched(ns);
-                let total = self.polder_size[self.polder[t0 as usize] as usize] - 2;
-                let mut odd = 0;
-                let mut known = 0;
-                for s in 0..ns {
-                    if self.group[s] as usize == s && gdone[s] {
-                        odd += gsize[s] & 1;
-                        known += gsize[s];
-                    }
-                }
-                if running == 1 {
-                    odd += (total - known) & 1;
-                } else {
-                    debug_assert_eq!(known, total, "parts add up to the polder");
-                }
-                // Certificate: the finished parts whole; for the running part, the paths
-                // along which its searches met, or only its seeds when it is one search
-                // (every triangle of that part then hangs off those seeds).
-                for s in 0..ns {
-                    let g = self.group[s] as usize;
-                    let alone = (0..ns).filter(|&r| self.group[r] as usize == g).count() == 1;
-                    self.cert_len[s] = if !gdone[g] && alone {
-                        self.nseed[s]
-                    } else {
-                        self.queue[s].len()
-                    };
-                }
-                return Check {
-                    allowed: odd <= 1,
-                    kind: KIND_SPLIT,
-                };
-            }
-        }
-    }
-
-    /// Root of vertex `v`'s dead component.
-    #[inline]
-    fn find(&self, mut v: u32) -> u32 {
-        while self.dsu_parent[v as usize] != v {
-            v = self.dsu_parent[v as usize];
-        }
-        v
-    }
-
-    /// Joins the dead components of `a` and `b` (logged); returns the root that was attached
-    /// under the other, if they were distinct.
-    fn union(&mut self, a: u32, b: u32) -> Option<u32> {
-        let (mut ra, mut rb) = (self.find(a), self.find(b));
-        if ra == rb {
-            return None;
-        }
-        if self.dsu_size[ra as usize] < self.dsu_size[rb as usize] {
-            std::mem::swap(&mut ra, &mut rb);
-        }
-        self.dsu_parent[rb as usize] = ra;
-        self.dsu_size[ra as usize] += self.dsu_size[rb as usize];
-        self.log.push(Op::Union {
-            child: rb,
-            root: ra,
-        });
-        Some(rb)
-    }
-
-    fn count_searched(&mut self, ns: usize) {
-        for s in 0..ns {
-            self.searched += self.queue[s].len() as u64;
-        }
-    }
-
     /// Recomputes the verdict of live candidate `c` and records its certificate.
     fn recheck_one(&mut self, c: u32) {
-        let r = self.check(c);
+        let mut r = self.check(c);
         let ci = c as usize;
-        let old_kind = self.kind[ci];
-        let old_allowed = self.allowed[ci];
-        if r.kind == KIND_LOCAL && old_kind == KIND_LOCAL && r.allowed == old_allowed {
+        let old = self.verdict[ci];
+        if r.kind == KIND_LOCAL
+            && old.kind == KIND_LOCAL
+            && r.allowed == old.allowed
+            && r.mask == old.mask
+        {
             return;
         }
-        self.log.push(Op::Verdict {
-            c,
-            ver: self.cert_ver[ci],
-            allowed: old_allowed,
-            kind: old_kind,
-        });
+        self.log.push(Op::Verdict { c, old });
         self.ver = self.ver.wrapping_add(1);
         let ver = self.ver;
-        self.cert_ver[ci] = ver;
-        self.kind[ci] = r.kind;
-        if r.allowed != old_allowed {
-            self.allowed[ci] = r.allowed;
+        r.ver = ver;
+        (r.cert, r.cert_len) = self.append_cert(r.kind, false);
+        self.verdict[ci] = r;
+        if r.allowed != old.allowed {
             let [t0, t1] = self.table.pairs[ci];
             for t in [t0, t1] {
                 let k = self.count[t as usize];
@@ -739,40 +548,35 @@ impl<'a> State<'a> {
         }
     }
 
-    /// Moves triangle `t` to bucket `new` (logged).
+    /// Moves triangle `t` from `P_old` to `P_new` (logged).
     fn set_count(&mut self, t: u32, new: u8) {
-        let ti = t as usize;
-        let old = self.count[ti];
+        let old = self.count[t as usize];
         if old == new {
             return;
         }
-        let mut p = NONE;
+        self.move_count(t, old, new);
+        self.log.push(Op::Count { t, old });
+    }
+
+    /// Sets the count of `t` from `old` to `new` and moves it between the sets.
+    #[inline]
+    fn move_count(&mut self, t: u32, old: u8, new: u8) {
         if old > 0 {
-            p = self.pos[ti];
-            let b = &mut self.bucket[old as usize];
-            b.swap_remove(p as usize);
-            if let Some(&y) = b.get(p as usize) {
-                self.pos[y as usize] = p;
-            }
+            self.sets.remove(old as usize, t);
         }
-        self.count[ti] = new;
         if new > 0 {
-            let b = &mut self.bucket[new as usize];
-            self.pos[ti] = b.len() as u32;
-            b.push(t);
+            self.sets.insert(new as usize, t);
         }
-        self.log.push(Op::Count { t, old, pos: p });
+        self.count[t as usize] = new;
     }
 
     fn set_verdict_dead(&mut self, c: u32) {
         let ci = c as usize;
         self.log.push(Op::Verdict {
             c,
-            ver: self.cert_ver[ci],
-            allowed: self.allowed[ci],
-            kind: self.kind[ci],
+            old: self.verdict[ci],
         });
-        self.allowed[ci] = false;
+        self.verdict[ci].allowed = false;
     }
 
     /// Marks the verdict of `c` as possibly stale (logged).
@@ -821,7 +625,7 @@ impl<'a> State<'a> {
     #[inline]
     pub fn is_allowed_lazy(&mut self, c: u32) -> bool {
         self.resolve(c);
-        self.allowed[c as usize]
+        self.verdict[c as usize].allowed
     }
 
     /// Exact number of allowed actions of `t` inside a lazy tree.
@@ -858,78 +662,19 @@ impl<'a> State<'a> {
         );
         // An exact verdict that found one part needs no new search; a split does (its
         // parts are relabelled).
-        let known = !self.dirty[ci] && self.allowed[ci] && self.kind[ci] != KIND_SPLIT;
-        let r = if known {
-            self.nsearch = 0;
-            Check {
-                allowed: true,
-                kind: self.kind[ci],
-            }
+        let v = self.verdict[ci];
+        let split = if !self.dirty[ci] && v.allowed && v.kind != KIND_SPLIT {
+            false
         } else {
-            self.check(c)
+            self.check(c).kind == KIND_SPLIT
         };
         self.log.push(Op::Apply(c));
-        // Polder bookkeeping.
-        let p = self.polder[t0 as usize];
-        let psize = self.polder_size[p as usize];
         self.changed.clear();
-        if r.kind == KIND_SPLIT {
-            let ns = self.nsearch;
-            // Whole parts found: each finished group; keep the old id for the running one,
-            // or for the largest when all finished.
-            let mut gsize = [0u32; 4];
-            let mut gdone = [true; 4];
-            for s in 0..ns {
-                let g = self.group[s] as usize;
-                gsize[g] += self.queue[s].len() as u32;
-                if self.head[s] < self.queue[s].len() {
-                    gdone[g] = false;
-                }
-            }
-            let mut keep = usize::MAX;
-            for g in 0..ns {
-                if self.group[g] as usize == g && !gdone[g] {
-                    keep = g;
-                }
-            }
-            if keep == usize::MAX {
-                for g in 0..ns {
-                    if self.group[g] as usize == g && (keep == usize::MAX || gsize[g] > gsize[keep])
-                    {
-                        keep = g;
-                    }
-                }
-            }
-            let mut known = 0;
-            for g in 0..ns {
-                if self.group[g] as usize != g || g == keep {
-                    continue;
-                }
-                let id = self.polder_size.len() as u32;
-                self.polder_size.push(gsize[g]);
-                self.log.push(Op::PolderNew);
-                known += gsize[g];
-                if gsize[g] % 2 != psize % 2 {
-                    self.changed.push(id);
-                }
-                for s in 0..ns {
-                    if self.group[s] as usize != g {
-                        continue;
-                    }
-                    for i in 0..self.queue[s].len() {
-                        let t = self.queue[s][i];
-                        self.log.push(Op::Polder { t, old: p });
-                        self.polder[t as usize] = id;
-                    }
-                }
-            }
-            let rest = psize - 2 - known;
-            if rest % 2 != psize % 2 {
-                self.changed.push(p);
-            }
-            self.log.push(Op::PolderSize { p, old: psize });
-            self.polder_size[p as usize] = rest;
+        if split {
+            self.relabel_split(t0);
         } else {
+            let p = self.polder[t0 as usize];
+            let psize = self.polder_size[p as usize];
             self.log.push(Op::PolderSize { p, old: psize });
             self.polder_size[p as usize] = psize - 2;
         }
@@ -945,7 +690,7 @@ impl<'a> State<'a> {
         for x in [t0, t1] {
             self.set_count(x, 0);
             for c2 in self.table.by_triangle[x as usize] {
-                if c2 != NONE && self.allowed[c2 as usize] {
+                if c2 != NONE && self.verdict[c2 as usize].allowed {
                     self.set_verdict_dead(c2);
                     let u = self.table.other(c2, x);
                     if self.alive[u as usize] {
@@ -972,7 +717,7 @@ impl<'a> State<'a> {
             if let Some(child) = self.union(qv[0], qv[i]) {
                 for j in 0..self.root_watch[child as usize].len() {
                     let (c2, ver) = self.root_watch[child as usize][j];
-                    if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
+                    if self.verdict[c2 as usize].ver == ver && self.is_live(c2) {
                         self.mark(c2);
                     }
                 }
@@ -991,7 +736,7 @@ impl<'a> State<'a> {
             // Marking touches no watch list: iterate the list taken out, then put it back.
             let list = std::mem::take(&mut self.watch[x as usize]);
             for &(c2, ver) in &list {
-                if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
+                if self.verdict[c2 as usize].ver == ver && self.is_live(c2) {
                     self.mark(c2);
                 }
             }
@@ -1013,7 +758,11 @@ impl<'a> State<'a> {
     /// Reverts the last `apply`. Panics when nothing was applied.
     pub fn undo(&mut self) {
         assert!(!self.chosen.is_empty(), "undo with nothing applied");
+        assert!(self.tree.is_empty(), "undo inside a look-ahead tree");
         while let Some(op) = self.log.pop() {
+            if self.undo_shared(op) {
+                continue;
+            }
             match op {
                 Op::Apply(c) => {
                     let [t0, t1] = self.table.pairs[c as usize];
@@ -1029,54 +778,22 @@ impl<'a> State<'a> {
                     self.quality.pop();
                     return;
                 }
-                Op::Verdict {
-                    c,
-                    ver,
-                    allowed,
-                    kind,
-                } => {
-                    let ci = c as usize;
-                    self.cert_ver[ci] = ver;
-                    self.allowed[ci] = allowed;
-                    self.kind[ci] = kind;
+                Op::Verdict { c, old } => self.verdict[c as usize] = old,
+                Op::Count { t, old } => {
+                    let cur = self.count[t as usize];
+                    self.move_count(t, cur, old);
                 }
-                Op::Count { t, old, pos } => {
-                    let ti = t as usize;
-                    let cur = self.count[ti];
-                    if cur > 0 {
-                        let x = self.bucket[cur as usize].pop();
-                        debug_assert_eq!(x, Some(t));
-                    }
-                    self.count[ti] = old;
-                    if old > 0 {
-                        let b = &mut self.bucket[old as usize];
-                        let p = pos as usize;
-                        if p == b.len() {
-                            b.push(t);
-                        } else {
-                            let y = b[p];
-                            b.push(y);
-                            self.pos[y as usize] = (b.len() - 1) as u32;
-                            b[p] = t;
-                        }
-                        self.pos[ti] = pos;
-                    }
-                }
-                Op::Polder { t, old } => self.polder[t as usize] = old,
-                Op::PolderNew => {
-                    self.polder_size.pop();
-                }
-                Op::PolderSize { p, old } => self.polder_size[p as usize] = old,
+                Op::TreeApply(_)
+                | Op::Polder { .. }
+                | Op::PolderNew
+                | Op::PolderSize { .. }
+                | Op::Union { .. } => unreachable!("handled by undo_shared"),
                 Op::Watch(t) => {
                     self.watch[t as usize].pop();
                 }
                 Op::SplitIns => {
                     let c = self.split.pop().expect("split entry");
                     self.split_pos[c as usize] = NONE;
-                }
-                Op::Union { child, root } => {
-                    self.dsu_parent[child as usize] = child;
-                    self.dsu_size[root as usize] -= self.dsu_size[child as usize];
                 }
                 Op::RootWatch(v) => {
                     self.root_watch[v as usize].pop();
@@ -1109,6 +826,26 @@ impl<'a> State<'a> {
         while !self.chosen.is_empty() {
             self.undo();
         }
+        self.base_cert.truncate(self.base_cert_init);
+    }
+
+    /// Reverts the changes that base applies and tree pushes share (polders, dead
+    /// components); false for any other change.
+    #[inline]
+    fn undo_shared(&mut self, op: Op) -> bool {
+        match op {
+            Op::Polder { t, old } => self.polder[t as usize] = old,
+            Op::PolderNew => {
+                self.polder_size.pop();
+            }
+            Op::PolderSize { p, old } => self.polder_size[p as usize] = old,
+            Op::Union { child, root } => {
+                self.dsu_parent[child as usize] = child;
+                self.dsu_size[root as usize] -= self.dsu_size[child as usize];
+            }
+            _ => return false,
+        }
+        true
     }
 
     /// Checks the state's internal invariants (buckets, counts, polder sizes) and the
@@ -1124,7 +861,7 @@ impl<'a> State<'a> {
             let expect = if self.alive[t] {
                 self.table.by_triangle[t]
                     .iter()
-                    .filter(|&&c| c != NONE && self.allowed[c as usize])
+                    .filter(|&&c| c != NONE && self.verdict[c as usize].allowed)
                     .count() as u8
             } else {
                 0
@@ -1132,23 +869,22 @@ impl<'a> State<'a> {
             if k != expect {
                 return Err(format!("triangle {t}: count {k}, allowed actions {expect}"));
             }
-            if k > 0 && self.bucket[k as usize][self.pos[t] as usize] != t as u32 {
-                return Err(format!("triangle {t}: bucket position wrong"));
-            }
         }
-        for k in 1..4 {
-            for &t in &self.bucket[k] {
-                if self.count[t as usize] as usize != k {
-                    return Err(format!("triangle {t} in bucket {k}"));
-                }
+        for k in 1..4u32 {
+            let members = self.bucket(k);
+            let expect: Vec<u32> = (0..nt as u32)
+                .filter(|&t| self.count[t as usize] as u32 == k)
+                .collect();
+            if members != expect {
+                return Err(format!("P_{k} holds {members:?}, counts say {expect:?}"));
             }
         }
         let naive = naive_allowed(self.mesh, self.table, &self.alive);
         for (c, &ok) in naive.iter().enumerate() {
-            if ok != self.allowed[c] {
+            if ok != self.verdict[c].allowed {
                 return Err(format!(
                     "candidate {c}: allowed {} but the naive criterion says {ok}",
-                    self.allowed[c]
+                    self.verdict[c].allowed
                 ));
             }
         }

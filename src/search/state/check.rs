@@ -1,0 +1,446 @@
+//! The criterion for one candidate in the current state (local proof, distinct dead
+//! components, lockstep search), the dead-component union–find, and the polder relabelling
+//! after a split. See the module docs of `state` for the rule and why it is exact.
+
+/// `clean_mask` bit: the local proof settles the verdict.
+pub(super) const LOCAL_PROOF: u8 = 1 << 4;
+
+use super::{
+    BLOCKED, DEAD, EPOCH_LIMIT, FLAG_SHARED_NEIGHBOUR, KIND_DISTINCT, KIND_LOCAL, KIND_MET,
+    KIND_SPLIT, Op, State, Verdict,
+};
+use crate::mesh::NONE;
+
+impl State<'_> {
+    /// Checks candidate `c` (both triangles remaining) in the current state. The verdict's
+    /// certificate is left in scratch (`queue[..nsearch]` up to `cert_len`, or
+    /// `arc_roots[..narcs]`; see [`State::append_cert`]); the searches' parts stay in
+    /// `queue` / `group` / `head` for [`State::relabel_split`].
+    pub(super) fn check(&mut self, c: u32) -> Verdict {
+        let mask = self.clean_mask(c);
+        if mask & LOCAL_PROOF != 0 {
+            self.nsearch = 0;
+            self.narcs = 0;
+            return Verdict {
+                allowed: true,
+                kind: KIND_LOCAL,
+                mask: mask & 0xF,
+                ..Verdict::default()
+            };
+        }
+        self.check_slow(c, mask & 0xF)
+    }
+
+    /// The quad vertices of candidate `c` that are clean (bits 0..4: closed fan, no used
+    /// triangle), plus `LOCAL_PROOF` when the links at those vertices join every remaining
+    /// neighbour of the quad (one part: the action is allowed). A handful of loads.
+    #[inline]
+    pub(super) fn clean_mask(&self, c: u32) -> u8 {
+        let n = self.cand_nb[c as usize];
+        let q = self.table.quads[c as usize];
+        let flags = self.cand_flags[c as usize];
+        let mut mask = 0u8;
+        let mut live_bits = 0u8;
+        for i in 0..4 {
+            if flags & (1 << i) != 0 && self.dead_count[q[i] as usize] == 0 {
+                mask |= 1 << i;
+            }
+            if n[i] != NONE && self.alive[n[i] as usize] {
+                live_bits |= 1 << i;
+            }
+        }
+        if flags & FLAG_SHARED_NEIGHBOUR == 0 {
+            // Neighbours i-1 and i are linked at quad vertex i when both remain and the
+            // vertex is clean; around the 4-cycle, groups = live - links (one when all 4
+            // links close the cycle).
+            let before = ((live_bits << 1) | (live_bits >> 3)) & 0xF;
+            let links = live_bits & before & mask;
+            let groups = live_bits.count_ones() - links.count_ones() + (links == 0xF) as u32;
+            if groups <= 1 {
+                return mask | LOCAL_PROOF;
+            }
+        }
+        mask
+    }
+
+    /// [`State::check`] when the local proof does not settle it (or the quad has a
+    /// neighbour across two of its sides); `mask`: the clean quad vertices.
+    pub(super) fn check_slow(&mut self, c: u32, mask: u8) -> Verdict {
+        let [t0, t1] = self.table.pairs[c as usize];
+        let n = self.cand_nb[c as usize];
+        let q = self.table.quads[c as usize];
+        // Group label of each neighbour slot, kept flat: joining relabels the 4 slots.
+        let mut root = [0u8, 1, 2, 3];
+        #[inline(always)]
+        fn join(r: &mut [u8; 4], a: usize, b: usize) {
+            let (x, y) = (r[a], r[b]);
+            if x != y {
+                for k in r.iter_mut() {
+                    if *k == y {
+                        *k = x;
+                    }
+                }
+            }
+        }
+        let mut live = [false; 4];
+        for i in 0..4 {
+            live[i] = n[i] != NONE && self.alive[n[i] as usize];
+        }
+        for i in 0..4 {
+            if !live[i] {
+                continue;
+            }
+            for j in 0..i {
+                if live[j] && n[i] == n[j] {
+                    join(&mut root, i, j);
+                }
+            }
+            let j = (i + 1) % 4;
+            if live[j] && mask & (1 << j) != 0 {
+                join(&mut root, i, j);
+            }
+        }
+        // Distinct groups of live neighbours: one search per group.
+        let mut sid = [u8::MAX; 4];
+        let mut ns = 0usize;
+        for i in 0..4 {
+            if live[i] {
+                let r = root[i] as usize;
+                if sid[r] == u8::MAX {
+                    sid[r] = ns as u8;
+                    ns += 1;
+                }
+            }
+        }
+        self.nsearch = 0;
+        self.narcs = 0;
+        let verdict = |allowed: bool, kind: u8| Verdict {
+            allowed,
+            kind,
+            mask,
+            ..Verdict::default()
+        };
+        if ns <= 1 {
+            return verdict(true, KIND_LOCAL);
+        }
+        // Where the quad touches the removed region: arcs of touched vertices joined by
+        // touched edges. A split needs one dead component to touch the quad twice.
+        let mut distinct = true;
+        for i in 0..4 {
+            let prev = (i + 3) % 4;
+            let touched = mask & (1 << i) == 0;
+            let touched_prev = mask & (1 << prev) == 0;
+            // Edge `prev` joins q[prev] and q[i]; touched when its neighbour is gone.
+            if touched && (live[prev] || !touched_prev) {
+                let r = self.find(q[i]);
+                if self.arc_roots[..self.narcs].contains(&r) {
+                    distinct = false;
+                    break;
+                }
+                self.arc_roots[self.narcs] = r;
+                self.narcs += 1;
+            }
+        }
+        if distinct && self.narcs > 0 {
+            return verdict(true, KIND_DISTINCT);
+        }
+        self.narcs = 0;
+        self.searches += 1;
+        self.epoch += 1;
+        if self.epoch > EPOCH_LIMIT {
+            self.stamp.iter_mut().for_each(|s| {
+                if *s != DEAD {
+                    *s = 0;
+                }
+            });
+            self.epoch = 1;
+        }
+        let base = self.epoch << 3;
+        self.stamp[t0 as usize] = base | BLOCKED;
+        self.stamp[t1 as usize] = base | BLOCKED;
+        self.nsearch = ns;
+        for s in 0..ns {
+            self.queue[s].clear();
+            self.head[s] = 0;
+            self.group[s] = s as u8;
+        }
+        for i in 0..4 {
+            if live[i] {
+                let t = n[i] as usize;
+                if self.stamp[t] < base {
+                    let s = sid[root[i] as usize];
+                    self.stamp[t] = base | s as u32;
+                    self.queue[s as usize].push(t as u32);
+                }
+            }
+        }
+        for s in 0..ns {
+            self.nseed[s] = self.queue[s].len();
+        }
+        let nb = &self.mesh.topology.neighbours;
+        loop {
+            // The verdict can only change when a search runs dry or two groups meet.
+            let mut event = false;
+            for s in 0..ns {
+                // Disjoint field borrows: the hot loop reads no other state.
+                let queue = &mut self.queue[s];
+                let stamp = &mut self.stamp;
+                let group = &mut self.group;
+                let h = self.head[s];
+                if h == queue.len() {
+                    continue;
+                }
+                let x = queue[h];
+                self.head[s] = h + 1;
+                let own = base | s as u32;
+                for &u in &nb[x as usize] {
+                    if u == NONE {
+                        continue;
+                    }
+                    let ui = u as usize;
+                    let m = stamp[ui];
+                    if m < base {
+                        stamp[ui] = own;
+                        queue.push(u);
+                    } else if m != own && m != DEAD && m != base | BLOCKED {
+                        // Another search's triangle. Groups are kept flat (`group[s]` is
+                        // the root), so a meeting is one comparison; a merge relabels the
+                        // (at most 4) members.
+                        let (a, b) = (group[(m & 7) as usize], group[s]);
+                        if a != b {
+                            for g in group[..ns].iter_mut() {
+                                if *g == a {
+                                    *g = b;
+                                }
+                            }
+                            event = true;
+                        }
+                    }
+                }
+                if h + 1 == queue.len() {
+                    event = true;
+                }
+            }
+            if !event {
+                continue;
+            }
+            // Groups and how many are still running.
+            let mut groups = 0;
+            let mut running = 0;
+            let mut gsize = [0u32; 4];
+            let mut gdone = [true; 4];
+            for s in 0..ns {
+                let g = self.group[s] as usize;
+                gsize[g] += self.queue[s].len() as u32;
+                if self.head[s] < self.queue[s].len() {
+                    gdone[g] = false;
+                }
+            }
+            for s in 0..ns {
+                if self.group[s] as usize == s {
+                    groups += 1;
+                    if !gdone[s] {
+                        running += 1;
+                    }
+                }
+            }
+            if groups == 1 {
+                self.count_searched(ns);
+                for s in 0..ns {
+                    self.cert_len[s] = self.queue[s].len();
+                }
+                return verdict(true, KIND_MET);
+            }
+            if running <= 1 {
+                self.count_searched(ns);
+                let total = self.polder_size[self.polder[t0 as usize] as usize] - 2;
+                let mut odd = 0;
+                let mut known = 0;
+                for s in 0..ns {
+                    if self.group[s] as usize == s && gdone[s] {
+                        odd += gsize[s] & 1;
+                        known += gsize[s];
+                    }
+                }
+                let mut all = odd;
+                if running == 1 {
+                    all += (total - known) & 1;
+                } else {
+                    debug_assert_eq!(known, total, "parts add up to the polder");
+                }
+                // Certificate: the finished parts whole; for the running part, the paths
+                // along which its searches met, or only its seeds when it is one search
+                // (every triangle of that part then hangs off those seeds).
+                for s in 0..ns {
+                    let g = self.group[s] as usize;
+                    let alone = (0..ns).filter(|&r| self.group[r] as usize == g).count() == 1;
+                    self.cert_len[s] = if !gdone[g] && alone {
+                        self.nseed[s]
+                    } else {
+                        self.queue[s].len()
+                    };
+                }
+                return Verdict {
+                    fin_odd: odd as u8,
+                    fin_known: known,
+                    ..verdict(all <= 1, KIND_SPLIT)
+                };
+            }
+        }
+    }
+
+    /// Appends the certificate of the last [`State::check`] (of a verdict of kind `kind`)
+    /// to the base arena (`tree == false`) or the tree's, and returns `(offset, length)`:
+    /// dead-component roots for `KIND_DISTINCT`, triangles for `KIND_MET` / `KIND_SPLIT`.
+    pub(super) fn append_cert(&mut self, kind: u8, tree: bool) -> (u32, u32) {
+        let arena = if tree {
+            &mut self.tree.cert
+        } else {
+            &mut self.base_cert
+        };
+        let off = arena.len();
+        if kind == KIND_DISTINCT {
+            arena.extend_from_slice(&self.arc_roots[..self.narcs]);
+        } else if kind != KIND_LOCAL {
+            for s in 0..self.nsearch {
+                arena.extend_from_slice(&self.queue[s][..self.cert_len[s]]);
+            }
+        }
+        (off as u32, (arena.len() - off) as u32)
+    }
+
+    /// Whether verdict `v` of candidate `c` (both triangles remaining) still holds in the
+    /// current state, reached from the state it was computed in by applying actions only
+    /// (never undoing past it); `Some(allowed)` if so, `None` if it must be recomputed. The
+    /// vertices that were clean must still be, its certificate (in `arena`) intact; a split's
+    /// verdict is re-derived from the current size of the polder (the running part is the
+    /// rest of it).
+    #[inline]
+    pub(super) fn still_holds(&self, c: u32, v: &Verdict, arena: &[u32]) -> Option<bool> {
+        if v.mask != 0 {
+            let q = self.table.quads[c as usize];
+            for i in 0..4 {
+                if v.mask & (1 << i) != 0 && self.dead_count[q[i] as usize] != 0 {
+                    return None;
+                }
+            }
+        }
+        if v.kind == KIND_LOCAL {
+            return Some(v.allowed);
+        }
+        let cert = &arena[v.cert as usize..(v.cert + v.cert_len) as usize];
+        if v.kind == KIND_DISTINCT {
+            return cert
+                .iter()
+                .all(|&r| self.dsu_parent[r as usize] == r)
+                .then_some(true);
+        }
+        if !cert.iter().all(|&t| self.alive[t as usize]) {
+            return None;
+        }
+        if v.kind == KIND_MET {
+            return Some(true);
+        }
+        let t0 = self.table.pairs[c as usize][0];
+        let total = self.polder_size[self.polder[t0 as usize] as usize] - 2;
+        let rest = total.wrapping_sub(v.fin_known);
+        Some(v.fin_odd as u32 + (rest & 1) <= 1)
+    }
+
+    /// Root of vertex `v`'s dead component.
+    #[inline]
+    pub(super) fn find(&self, mut v: u32) -> u32 {
+        while self.dsu_parent[v as usize] != v {
+            v = self.dsu_parent[v as usize];
+        }
+        v
+    }
+
+    /// Joins the dead components of `a` and `b` (logged); returns the root that was attached
+    /// under the other, if they were distinct.
+    pub(super) fn union(&mut self, a: u32, b: u32) -> Option<u32> {
+        let (mut ra, mut rb) = (self.find(a), self.find(b));
+        if ra == rb {
+            return None;
+        }
+        if self.dsu_size[ra as usize] < self.dsu_size[rb as usize] {
+            std::mem::swap(&mut ra, &mut rb);
+        }
+        self.dsu_parent[rb as usize] = ra;
+        self.dsu_size[ra as usize] += self.dsu_size[rb as usize];
+        self.log.push(Op::Union {
+            child: rb,
+            root: ra,
+        });
+        Some(rb)
+    }
+
+    fn count_searched(&mut self, ns: usize) {
+        for s in 0..ns {
+            self.searched += self.queue[s].len() as u64;
+        }
+    }
+
+    /// After a [`State::check`] that found a split of the polder of `t0`: gives each
+    /// finished part a new polder id (logged) and the rest (the running part, or the largest
+    /// when all finished) the old id with its new size. The ids whose size changed parity
+    /// are left in `changed`.
+    pub(super) fn relabel_split(&mut self, t0: u32) {
+        let p = self.polder[t0 as usize];
+        let psize = self.polder_size[p as usize];
+        let ns = self.nsearch;
+        // Whole parts found: each finished group; keep the old id for the running one, or
+        // for the largest when all finished.
+        let mut gsize = [0u32; 4];
+        let mut gdone = [true; 4];
+        for s in 0..ns {
+            let g = self.group[s] as usize;
+            gsize[g] += self.queue[s].len() as u32;
+            if self.head[s] < self.queue[s].len() {
+                gdone[g] = false;
+            }
+        }
+        let mut keep = usize::MAX;
+        for g in 0..ns {
+            if self.group[g] as usize == g && !gdone[g] {
+                keep = g;
+            }
+        }
+        if keep == usize::MAX {
+            for g in 0..ns {
+                if self.group[g] as usize == g && (keep == usize::MAX || gsize[g] > gsize[keep]) {
+                    keep = g;
+                }
+            }
+        }
+        let mut known = 0;
+        for g in 0..ns {
+            if self.group[g] as usize != g || g == keep {
+                continue;
+            }
+            let id = self.polder_size.len() as u32;
+            self.polder_size.push(gsize[g]);
+            self.log.push(Op::PolderNew);
+            known += gsize[g];
+            if gsize[g] % 2 != psize % 2 {
+                self.changed.push(id);
+            }
+            for s in 0..ns {
+                if self.group[s] as usize != g {
+                    continue;
+                }
+                for i in 0..self.queue[s].len() {
+                    let t = self.queue[s][i];
+                    self.log.push(Op::Polder { t, old: p });
+                    self.polder[t as usize] = id;
+                }
+            }
+        }
+        let rest = psize - 2 - known;
+        if rest % 2 != psize % 2 {
+            self.changed.push(p);
+        }
+        self.log.push(Op::PolderSize { p, old: psize });
+        self.polder_size[p as usize] = rest;
+    }
+}

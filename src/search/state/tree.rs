@@ -1,0 +1,493 @@
+//! Look-ahead trees on top of the exact base state.
+//!
+//! `tree_push(c)` / `tree_pop()` change only what the criterion reads: the remaining
+//! triangles (and their search marks), the fans' used-triangle counts, the dead components
+//! and the polders. Nothing about verdicts is written on a push: a verdict asked for inside
+//! the tree ([`State::tree_allowed`]) is, in this order,
+//! 1. the tree's own verdict for the candidate, when it was computed at this node or an
+//!    ancestor of it and still holds;
+//! 2. the base verdict (exact at the root), when it still holds;
+//! 3. recomputed, and kept (with its certificate in the tree's arena) for this node and its
+//!    descendants.
+//!
+//! "Still holds" ([`State::still_holds`]) is decided on reading: the vertices that were
+//! clean are clean, the certificate is intact (the triangles remain, the dead-component roots
+//! are roots) and, for a split, the verdict is re-derived from the polder's current size.
+//! Going down a path only removes triangles, so these conditions are exactly the ones the
+//! base state's certificates rely on (module docs of `state`).
+//!
+//! `P_min` at a node below the root (needed only when no triangle next to the path's quads
+//! can be recombined) is the base sets corrected by every triangle whose count the path can
+//! have changed: the path's triangles and their partners, the candidates at the path's quad
+//! vertices, the base verdicts watching a removed triangle or a merged dead component, and
+//! the base split verdicts (their polder's parity may differ).
+
+use super::check::LOCAL_PROOF;
+use super::{DEAD, KIND_LOCAL, KIND_SPLIT, Op, State, Verdict};
+use crate::mesh::NONE;
+
+/// The tree's side of the state: its path, its verdict cache and scratch.
+#[derive(Debug, Clone)]
+pub(super) struct Overlay {
+    /// Verdicts computed inside the tree, with the node they were computed at.
+    verdict: Vec<Verdict>,
+    serial_of: Vec<u32>,
+    depth_of: Vec<u32>,
+    /// Ancestors' verdicts overwritten below them, restored when the node is popped:
+    /// `(depth of the overwriting node, candidate, verdict, its depth, its serial)`.
+    shadowed: Vec<(u32, u32, Verdict, u32, u32)>,
+    /// The counts of the triangles across the sides of the path's quads (`tree_near`), per
+    /// depth d a segment of 4·d slots at offset 2·d·(d-1): triangle (or NONE), its count,
+    /// and whether every action it has was dead or allowed by the local proof.
+    slots: Vec<(u32, u8, bool)>,
+    /// Serial number of the node each depth's segment was computed at.
+    slots_serial: Vec<u32>,
+    /// Per vertex: serial number of the deepest node of the current path whose push used a
+    /// triangle around it (restored on pop from `touched_log`).
+    touched_at: Vec<u32>,
+    touched_log: Vec<u32>,
+    /// Per triangle: its vertices and the vertex opposite each of its sides (NONE without
+    /// a neighbour), i.e. every vertex of every quad it can be part of.
+    ring: Vec<[u32; 6]>,
+    /// Certificates of the tree's verdicts (cleared at each `tree_begin`).
+    pub(super) cert: Vec<u32>,
+    /// Actions pushed, and the serial number of the node at each depth (0: the root).
+    path: Vec<u32>,
+    serial: Vec<u32>,
+    next_serial: u32,
+    /// Scratch for `P_min` below the root.
+    affected: Vec<u32>,
+    affected_mark: Vec<u32>,
+    affected_epoch: u32,
+    new_count: Vec<u8>,
+    removed: Vec<u32>,
+    added: Vec<u32>,
+    /// Log length at `tree_begin`.
+    log_start: usize,
+}
+
+impl Overlay {
+    pub(super) fn new(m: usize, nv: usize, ring: Vec<[u32; 6]>) -> Overlay {
+        let nt = ring.len();
+        Overlay {
+            slots: Vec::new(),
+            slots_serial: Vec::new(),
+            touched_at: vec![0; nv],
+            touched_log: Vec::new(),
+            ring,
+            verdict: vec![Verdict::default(); m],
+            serial_of: vec![0; m],
+            depth_of: vec![0; m],
+            shadowed: Vec::new(),
+            cert: Vec::new(),
+            path: Vec::new(),
+            serial: Vec::new(),
+            next_serial: 0,
+            affected: Vec::new(),
+            affected_mark: vec![0; nt],
+            affected_epoch: 0,
+            new_count: Vec::new(),
+            removed: Vec::new(),
+            added: Vec::new(),
+            log_start: 0,
+        }
+    }
+
+    /// No action pushed.
+    pub(super) fn is_empty(&self) -> bool {
+        self.path.is_empty()
+    }
+}
+
+impl State<'_> {
+    /// Starts a look-ahead tree at the current state (resolves every base verdict). Nothing
+    /// may be pushed.
+    pub fn tree_begin(&mut self) {
+        assert!(self.tree.is_empty(), "tree_begin with actions pushed");
+        self.resolve_all();
+        let tr = &mut self.tree;
+        if tr.next_serial >= u32::MAX - (1 << 20) {
+            // Serial numbers are about to wrap: forget every cached verdict.
+            tr.serial_of.iter_mut().for_each(|s| *s = 0);
+            tr.slots_serial.iter_mut().for_each(|s| *s = 0);
+            tr.touched_at.iter_mut().for_each(|s| *s = 0);
+            tr.next_serial = 0;
+        }
+        tr.next_serial += 1;
+        tr.serial.clear();
+        tr.serial.push(tr.next_serial);
+        tr.shadowed.clear();
+        tr.cert.clear();
+        tr.log_start = self.log.len();
+    }
+
+    /// Number of actions pushed since `tree_begin`.
+    #[inline]
+    pub fn tree_depth(&self) -> usize {
+        self.tree.path.len()
+    }
+
+    /// The actions pushed, root first.
+    pub fn tree_path(&self) -> &[u32] {
+        &self.tree.path
+    }
+
+    /// True when candidate `c` may be applied at the current node: both triangles remain
+    /// and the criterion allows it.
+    #[inline]
+    pub fn tree_allowed(&mut self, c: u32) -> bool {
+        self.is_live(c) && self.tree_verdict(c).0
+    }
+
+    /// Number of allowed actions of triangle `t` at the current node (0 if used).
+    pub fn tree_count(&mut self, t: u32) -> u32 {
+        if !self.alive[t as usize] {
+            return 0;
+        }
+        if self.tree.is_empty() {
+            return self.count[t as usize] as u32;
+        }
+        let mut k = 0;
+        for c in self.table.by_triangle[t as usize] {
+            if c != NONE && self.tree_allowed(c) {
+                k += 1;
+            }
+        }
+        k
+    }
+
+    /// The triangles across the four sides of each quad of the path (root first, sides in
+    /// quad order; NONE where there is none) with their number of allowed actions at the
+    /// current node (0 when used). Incremental: a slot of the parent node is kept when all
+    /// its triangle's actions were dead or allowed by the local proof there and the last
+    /// push used no triangle around any vertex of those actions' quads.
+    pub fn tree_near(&mut self) -> &[(u32, u8, bool)] {
+        let d = self.tree.path.len();
+        let at = |d: usize| 2 * d * d.saturating_sub(1);
+        let (start, end) = (at(d), at(d) + 4 * d);
+        if d == 0 {
+            return &[];
+        }
+        let tr = &mut self.tree;
+        if tr.slots.len() < end {
+            tr.slots.resize(end, (NONE, 0, true));
+        }
+        if tr.slots_serial.len() <= d {
+            tr.slots_serial.resize(d + 1, 0);
+        }
+        let here = tr.serial[d];
+        if tr.slots_serial[d] == here {
+            return &self.tree.slots[start..end];
+        }
+        let parent_ok = d >= 2 && tr.slots_serial[d - 1] == tr.serial[d - 1];
+        for i in 0..4 * d {
+            let tr = &self.tree;
+            let t = if i < 4 * (d - 1) && parent_ok {
+                let (t, k, local) = tr.slots[at(d - 1) + i];
+                let keep = t == NONE
+                    || (local
+                        && tr.ring[t as usize]
+                            .iter()
+                            .all(|&v| v == NONE || tr.touched_at[v as usize] != here));
+                if keep {
+                    self.tree.slots[start + i] = (t, k, local);
+                    continue;
+                }
+                t
+            } else {
+                self.cand_nb[tr.path[i / 4] as usize][i % 4]
+            };
+            let slot = if t == NONE {
+                (NONE, 0, true)
+            } else {
+                let (k, local) = self.count_local(t);
+                (t, k as u8, local)
+            };
+            self.tree.slots[start + i] = slot;
+        }
+        self.tree.slots_serial[d] = here;
+        &self.tree.slots[start..end]
+    }
+
+    /// Allowed actions of `t` at the current node, and whether each of its actions is dead
+    /// or allowed by the local proof.
+    fn count_local(&mut self, t: u32) -> (u32, bool) {
+        if !self.alive[t as usize] {
+            return (0, true);
+        }
+        let mut k = 0;
+        let mut local = true;
+        for c in self.table.by_triangle[t as usize] {
+            if c != NONE && self.is_live(c) {
+                let (allowed, kind) = self.tree_verdict(c);
+                k += allowed as u32;
+                local &= allowed && kind == KIND_LOCAL;
+            }
+        }
+        (k, local)
+    }
+
+    /// `(allowed, kind)` of live candidate `c` at the current node.
+    fn tree_verdict(&mut self, c: u32) -> (bool, u8) {
+        let ci = c as usize;
+        let tr = &self.tree;
+        let d = tr.path.len();
+        if d == 0 {
+            let v = &self.verdict[ci];
+            return (v.allowed, v.kind);
+        }
+        // The local proof costs a few loads: cheaper than looking anything up. When it
+        // fails, no verdict of the local kind can still hold either.
+        let mask = self.clean_mask(c);
+        if mask & LOCAL_PROOF != 0 {
+            return (true, KIND_LOCAL);
+        }
+        let od = tr.depth_of[ci] as usize;
+        let ancestor = od <= d && tr.serial[od] == tr.serial_of[ci];
+        if ancestor {
+            let v = tr.verdict[ci];
+            if let Some(a) = self.still_holds(c, &v, &tr.cert) {
+                return (a, v.kind);
+            }
+        }
+        let v = self.verdict[ci];
+        if v.kind != KIND_LOCAL {
+            if let Some(a) = self.still_holds(c, &v, &self.base_cert) {
+                return (a, v.kind);
+            }
+        }
+        let mut v = self.check_slow(c, mask);
+        (v.cert, v.cert_len) = self.append_cert(v.kind, true);
+        let tr = &mut self.tree;
+        if ancestor && od < d {
+            let old = (d as u32, c, tr.verdict[ci], od as u32, tr.serial_of[ci]);
+            tr.shadowed.push(old);
+        }
+        tr.verdict[ci] = v;
+        tr.depth_of[ci] = d as u32;
+        tr.serial_of[ci] = tr.serial[d];
+        (v.allowed, v.kind)
+    }
+
+    /// Recombines the pair of candidate `c` (both must remain) inside the tree.
+    pub fn tree_push(&mut self, c: u32) {
+        assert!(
+            self.is_live(c),
+            "tree_push({c}): a triangle of the pair is already used"
+        );
+        let ci = c as usize;
+        let [t0, t1] = self.table.pairs[ci];
+        let (_, kind) = self.tree_verdict(c);
+        self.log.push(Op::TreeApply(c));
+        if kind == KIND_SPLIT {
+            // The parts are needed to relabel them: search again (the smaller parts).
+            let again = self.check(c);
+            debug_assert_eq!(again.kind, KIND_SPLIT);
+            self.changed.clear();
+            self.relabel_split(t0);
+        } else {
+            let p = self.polder[t0 as usize];
+            let old = self.polder_size[p as usize];
+            self.log.push(Op::PolderSize { p, old });
+            self.polder_size[p as usize] = old - 2;
+        }
+        for x in [t0, t1] {
+            self.alive[x as usize] = false;
+            self.stamp[x as usize] = DEAD;
+            for v in self.mesh.triangles[x as usize] {
+                self.dead_count[v as usize] += 1;
+            }
+        }
+        self.remaining -= 2;
+        let q = self.table.quads[ci];
+        for i in 1..4 {
+            self.union(q[0], q[i]);
+        }
+        let tr = &mut self.tree;
+        tr.next_serial += 1;
+        tr.path.push(c);
+        tr.serial.push(tr.next_serial);
+        for v in q {
+            tr.touched_log.push(tr.touched_at[v as usize]);
+            tr.touched_at[v as usize] = tr.next_serial;
+        }
+    }
+
+    /// Reverts the last `tree_push`. Panics when nothing was pushed.
+    pub fn tree_pop(&mut self) {
+        assert!(!self.tree.is_empty(), "tree_pop with nothing pushed");
+        let tr = &mut self.tree;
+        let d = tr.path.len() as u32;
+        while let Some(&(at, c, v, od, serial)) = tr.shadowed.last() {
+            if at < d {
+                break;
+            }
+            let ci = c as usize;
+            (tr.verdict[ci], tr.depth_of[ci], tr.serial_of[ci]) = (v, od, serial);
+            tr.shadowed.pop();
+        }
+        let c = tr.path.pop().expect("a pushed action");
+        for v in self.table.quads[c as usize].into_iter().rev() {
+            tr.touched_at[v as usize] = tr.touched_log.pop().expect("logged");
+        }
+        tr.serial.pop();
+        while let Some(op) = self.log.pop() {
+            if self.undo_shared(op) {
+                continue;
+            }
+            let Op::TreeApply(c) = op else {
+                unreachable!("a base change inside a look-ahead tree");
+            };
+            for x in self.table.pairs[c as usize] {
+                self.alive[x as usize] = true;
+                self.stamp[x as usize] = 0;
+                for v in self.mesh.triangles[x as usize] {
+                    self.dead_count[v as usize] -= 1;
+                }
+            }
+            self.remaining += 2;
+            return;
+        }
+        unreachable!("tree log without a TreeApply marker");
+    }
+
+    /// Draws from `P_min` at the current node: `pick(n)` chooses an index in `0..n`, and the
+    /// triangle returned is the member with that many members of smaller id. `None` when no
+    /// action is allowed.
+    pub fn tree_pick_pmin(&mut self, mut pick: impl FnMut(usize) -> usize) -> Option<u32> {
+        if self.tree.is_empty() {
+            let k = self.min_k()?;
+            let i = pick(self.bucket_len(k));
+            return Some(self.bucket_nth(k, i));
+        }
+        self.collect_affected();
+        let aff = std::mem::take(&mut self.tree.affected);
+        let mut new_count = std::mem::take(&mut self.tree.new_count);
+        new_count.clear();
+        for &t in &aff {
+            new_count.push(self.tree_count(t) as u8);
+        }
+        let mut found = None;
+        for k in 1..4u8 {
+            let (mut removed, mut added) = (0usize, 0usize);
+            for (&t, &n) in aff.iter().zip(&new_count) {
+                let old = self.count[t as usize];
+                removed += (old == k && n != k) as usize;
+                added += (old != k && n == k) as usize;
+            }
+            let size = self.sets.len(k as usize) - removed + added;
+            if size > 0 {
+                found = Some((k, size));
+                break;
+            }
+        }
+        let picked = found.map(|(k, size)| {
+            let i = pick(size);
+            self.tree.removed.clear();
+            self.tree.added.clear();
+            for (&t, &n) in aff.iter().zip(&new_count) {
+                let old = self.count[t as usize];
+                if old == k && n != k {
+                    self.tree.removed.push(t);
+                } else if old != k && n == k {
+                    self.tree.added.push(t);
+                }
+            }
+            self.tree.removed.sort_unstable();
+            self.tree.added.sort_unstable();
+            self.nth_corrected(k as usize, i)
+        });
+        self.tree.affected = aff;
+        self.tree.new_count = new_count;
+        picked
+    }
+
+    /// The member with `i` members of smaller id of `P_k` minus `tree.removed` plus
+    /// `tree.added` (both sorted): binary search on the id.
+    fn nth_corrected(&self, k: usize, i: usize) -> u32 {
+        let tr = &self.tree;
+        // Members with id below x.
+        let below = |x: u32| {
+            self.sets.rank(k, x) - tr.removed.partition_point(|&t| t < x)
+                + tr.added.partition_point(|&t| t < x)
+        };
+        let (mut lo, mut hi) = (0u32, self.alive.len() as u32 - 1);
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if below(mid + 1) > i {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        lo
+    }
+
+    /// Fills `tree.affected` with every remaining-or-used triangle whose number of allowed
+    /// actions may differ between the root and the current node (module docs).
+    fn collect_affected(&mut self) {
+        let tr = &mut self.tree;
+        tr.affected.clear();
+        tr.affected_epoch = tr.affected_epoch.wrapping_add(1);
+        if tr.affected_epoch == 0 {
+            tr.affected_mark.iter_mut().for_each(|m| *m = 0);
+            tr.affected_epoch = 1;
+        }
+        let epoch = tr.affected_epoch;
+        let table = self.table;
+        let add_pair = |tr: &mut Overlay, c: u32| {
+            for t in table.pairs[c as usize] {
+                if tr.affected_mark[t as usize] != epoch {
+                    tr.affected_mark[t as usize] = epoch;
+                    tr.affected.push(t);
+                }
+            }
+        };
+        for i in 0..tr.path.len() {
+            let c = tr.path[i];
+            for x in table.pairs[c as usize] {
+                for c2 in table.by_triangle[x as usize] {
+                    if c2 != NONE {
+                        add_pair(tr, c2);
+                    }
+                }
+                for &(c2, ver) in &self.watch[x as usize] {
+                    if self.verdict[c2 as usize].ver == ver {
+                        add_pair(tr, c2);
+                    }
+                }
+            }
+            for v in table.quads[c as usize] {
+                let v = v as usize;
+                for j in self.vc_start[v]..self.vc_start[v + 1] {
+                    add_pair(tr, self.vc_list[j as usize]);
+                }
+            }
+        }
+        // Without a split on the path every polder lost an even number of triangles, so
+        // no polder parity changed and the base split verdicts still read the same.
+        let mut split_on_path = false;
+        for op in &self.log[tr.log_start..] {
+            match *op {
+                Op::Union { child, .. } => {
+                    for &(c2, ver) in &self.root_watch[child as usize] {
+                        if self.verdict[c2 as usize].ver == ver {
+                            add_pair(tr, c2);
+                        }
+                    }
+                }
+                Op::PolderNew => split_on_path = true,
+                _ => {}
+            }
+        }
+        if split_on_path {
+            for &c2 in &self.split {
+                if self.alive[table.pairs[c2 as usize][0] as usize]
+                    && self.alive[table.pairs[c2 as usize][1] as usize]
+                {
+                    add_pair(tr, c2);
+                }
+            }
+        }
+    }
+}
