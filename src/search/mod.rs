@@ -152,6 +152,10 @@ pub struct Searcher<'a> {
     nodes: u64,
     near: Vec<u32>,
     used: Vec<bool>,
+    /// Uniform tree: ranks of the actions allowed at the root; per depth, the ranks the
+    /// path may have allowed.
+    allowed_ranks: Vec<u32>,
+    extra: Vec<Vec<u32>>,
 }
 
 impl<'a> Searcher<'a> {
@@ -167,8 +171,11 @@ impl<'a> Searcher<'a> {
         for (i, &c) in order.iter().enumerate() {
             rank[c as usize] = i as u32;
         }
+        let mut state = State::new(mesh, table);
+        // Runs never undo an applied action: no undo log, reset by copying.
+        state.set_forward(true);
         Searcher {
-            state: State::new(mesh, table),
+            state,
             order,
             rank,
             revisit: std::collections::BinaryHeap::new(),
@@ -176,6 +183,8 @@ impl<'a> Searcher<'a> {
             rng: ChaCha8Rng::seed_from_u64(0),
             nodes: 0,
             near: Vec::new(),
+            allowed_ranks: Vec::new(),
+            extra: Vec::new(),
             used: vec![false; mesh.num_triangles()],
         }
     }

@@ -102,6 +102,12 @@ impl Searcher<'_> {
             let mut best = f64::NEG_INFINITY;
             let mut first = NONE;
             self.state.tree_begin();
+            self.allowed_ranks.clear();
+            for r in self.cursor..self.order.len() {
+                if self.state.is_allowed(self.order[r]) {
+                    self.allowed_ranks.push(r as u32);
+                }
+            }
             self.uniform_dfs(0, h, 0.0, top, NONE, &mut best, &mut first);
             if first == NONE {
                 break;
@@ -127,11 +133,39 @@ impl Searcher<'_> {
         let table = self.state.table();
         let rest = (h - d - 1) as f64 * top;
         let mut any = false;
-        let mut i = self.cursor;
         let mut expanded = false;
-        while i < self.order.len() {
-            let c = self.order[i];
-            i += 1;
+        // Ranks to look at, in order: the actions allowed at the root and, below it, the
+        // actions forbidden at the root that the path may have allowed (every other action
+        // reads as at the root: `tree_affected`).
+        let du = d as usize;
+        if self.extra.len() <= du {
+            self.extra.resize_with(du + 1, Vec::new);
+        }
+        let mut extra = std::mem::take(&mut self.extra[du]);
+        extra.clear();
+        if d > 0 {
+            self.state.tree_affected(&mut extra);
+            let (state, rank, cursor) = (&self.state, &self.rank, self.cursor);
+            extra.retain(|&c| !state.is_allowed(c) && rank[c as usize] as usize >= cursor);
+            extra.iter_mut().for_each(|c| *c = rank[*c as usize]);
+            extra.sort_unstable();
+            extra.dedup();
+        }
+        let (mut i, mut j) = (0, 0);
+        loop {
+            let a = self.allowed_ranks.get(i).copied().unwrap_or(u32::MAX);
+            let b = extra.get(j).copied().unwrap_or(u32::MAX);
+            if a == u32::MAX && b == u32::MAX {
+                break;
+            }
+            let r = if a < b {
+                i += 1;
+                a
+            } else {
+                j += 1;
+                b
+            };
+            let c = self.order[r as usize];
             if !self.state.tree_allowed(c) {
                 continue;
             }
@@ -157,6 +191,7 @@ impl Searcher<'_> {
                 self.state.tree_pop();
             }
         }
+        self.extra[du] = extra;
         if !any && d > 0 && partial > *best {
             // No action left: a shorter sequence is a leaf.
             *best = partial;

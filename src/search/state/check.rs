@@ -5,9 +5,29 @@
 /// `clean_mask` bit: the local proof settles the verdict.
 pub(super) const LOCAL_PROOF: u8 = 1 << 4;
 
+/// The local proof by table, indexed by `live | clean << 4` (4 bits each, quad side / vertex
+/// order): neighbours i-1 and i are linked at quad vertex i when both remain and the vertex
+/// is clean; it holds when the links leave at most one group of remaining neighbours.
+const LOCAL_OK: [bool; 256] = {
+    let mut table = [false; 256];
+    let mut idx = 0;
+    while idx < 256 {
+        let (live, clean) = (idx & 0xF, idx >> 4);
+        let before = ((live << 1) | (live >> 3)) & 0xF;
+        let links = live & before & clean;
+        let groups = if links == 0xF {
+            1
+        } else {
+            (live as u32).count_ones() - (links as u32).count_ones()
+        };
+        table[idx] = groups <= 1;
+        idx += 1;
+    }
+    table
+};
+
 use super::{
-    BLOCKED, DEAD, EPOCH_LIMIT, FLAG_SHARED_NEIGHBOUR, KIND_DISTINCT, KIND_LOCAL, KIND_MET,
-    KIND_SPLIT, Op, State, Verdict,
+    BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT, Op, State, Verdict,
 };
 use crate::mesh::NONE;
 
@@ -36,33 +56,21 @@ impl State<'_> {
     /// neighbour of the quad (one part: the action is allowed). A handful of loads.
     #[inline]
     pub(super) fn clean_mask(&self, c: u32) -> u8 {
-        let n = self.cand_nb[c as usize];
-        let q = self.table.quads[c as usize];
-        let flags = self.cand_flags[c as usize];
+        let l = &self.cand_local[c as usize];
         let mut mask = 0u8;
         let mut live_bits = 0u8;
         for i in 0..4 {
-            if flags & (1 << i) != 0 && self.dead_count[q[i] as usize] == 0 {
-                mask |= 1 << i;
-            }
-            if n[i] != NONE && self.alive[n[i] as usize] {
-                live_bits |= 1 << i;
-            }
+            mask |= ((self.dead_count[l.quad[i] as usize] == 0) as u8) << i;
+            // `get` answers false for NONE (out of range): no separate test.
+            live_bits |= ((self.alive.get(l.nb[i] as usize) == Some(&true)) as u8) << i;
         }
-        if flags & FLAG_SHARED_NEIGHBOUR == 0 {
-            // Neighbours i-1 and i are linked at quad vertex i when both remain and the
-            // vertex is clean; around the 4-cycle, groups = live - links (one when all 4
-            // links close the cycle).
-            let before = ((live_bits << 1) | (live_bits >> 3)) & 0xF;
-            let links = live_bits & before & mask;
-            let groups = live_bits.count_ones() - links.count_ones() + (links == 0xF) as u32;
-            if groups <= 1 {
-                return mask | LOCAL_PROOF;
-            }
+        mask &= l.flags;
+        if LOCAL_OK[(live_bits | mask << 4) as usize] && !l.shared {
+            mask | LOCAL_PROOF
+        } else {
+            mask
         }
-        mask
     }
-
     /// [`State::check`] when the local proof does not settle it (or the quad has a
     /// neighbour across two of its sides); `mask`: the clean quad vertices.
     pub(super) fn check_slow(&mut self, c: u32, mask: u8) -> Verdict {

@@ -56,8 +56,17 @@ const KIND_SPLIT: u8 = 2;
 /// The quad touches removed regions in several places, all in distinct dead components:
 /// one part. Depends on those components staying distinct.
 const KIND_DISTINCT: u8 = 3;
-/// `cand_flags` bit: one triangle neighbours the quad across two of its sides.
-const FLAG_SHARED_NEIGHBOUR: u8 = 1 << 4;
+/// What the local proof of a candidate reads, in one place.
+#[derive(Debug, Clone, Copy)]
+struct CandLocal {
+    /// The quad's vertices and the neighbours across its sides (NONE where none).
+    quad: [u32; 4],
+    nb: [u32; 4],
+    /// Bit i: quad vertex i has a closed fan.
+    flags: u8,
+    /// One triangle neighbours the quad across two of its sides (no local proof then).
+    shared: bool,
+}
 /// Owner mark for the two triangles being removed during a search.
 const BLOCKED: u32 = 7;
 /// Search mark of a used triangle: above every epoch's marks, so one comparison tells an
@@ -122,6 +131,23 @@ struct Verdict {
     ver: u32,
 }
 
+/// What forward mode resets to (see [`State::set_forward`]).
+#[derive(Debug, Clone)]
+struct Initial {
+    verdict: Vec<Verdict>,
+    count: Vec<u8>,
+    sets: OrderedSets,
+    polder: Vec<u32>,
+    polder_size: Vec<u32>,
+    dsu_parent: Vec<u32>,
+    dsu_size: Vec<u32>,
+    split: Vec<u32>,
+    split_pos: Vec<u32>,
+    watch_len: Vec<u32>,
+    root_watch_len: Vec<u32>,
+    ver: u32,
+}
+
 /// The recombination state. See the module docs.
 #[derive(Debug, Clone)]
 pub struct State<'a> {
@@ -132,8 +158,8 @@ pub struct State<'a> {
     cand_nb: Vec<[u32; 4]>,
     /// Vertex fan is one closed cycle of triangles in the dual graph.
     closed: Vec<bool>,
-    /// Per candidate: bit i set when quad vertex i has a closed fan; `FLAG_SHARED_NEIGHBOUR`.
-    cand_flags: Vec<u8>,
+    /// Per candidate: what the local proof reads.
+    cand_local: Vec<CandLocal>,
     /// Candidates whose quad has vertex `v` (CSR).
     vc_start: Vec<u32>,
     vc_list: Vec<u32>,
@@ -170,6 +196,9 @@ pub struct State<'a> {
     log: Vec<Op>,
     /// The look-ahead tree on top of the base state.
     tree: Overlay,
+    /// Forward mode (`set_forward`) and the initial state it resets to.
+    forward: bool,
+    initial: Option<Box<Initial>>,
     // ---- scratch ----
     /// Search marks: `epoch << 3 | owner` (owner = search index or `BLOCKED`) for a triangle
     /// visited by the current search, lower for an unvisited one, `DEAD` for a used one.
@@ -280,19 +309,22 @@ impl<'a> State<'a> {
                 fill[v as usize] += 1;
             }
         }
-        let cand_flags: Vec<u8> = (0..m)
+        let cand_local: Vec<CandLocal> = (0..m)
             .map(|c| {
-                let (q, n) = (table.quads[c], cand_nb[c]);
-                let mut f = 0u8;
+                let (quad, nb) = (table.quads[c], cand_nb[c]);
+                let mut l = CandLocal {
+                    quad,
+                    nb,
+                    flags: 0,
+                    shared: false,
+                };
                 for i in 0..4 {
-                    if closed[q[i] as usize] {
-                        f |= 1 << i;
+                    if closed[quad[i] as usize] {
+                        l.flags |= 1 << i;
                     }
-                    if n[i] != NONE && (0..i).any(|j| n[j] == n[i]) {
-                        f |= FLAG_SHARED_NEIGHBOUR;
-                    }
+                    l.shared |= nb[i] != NONE && (0..i).any(|j| nb[j] == nb[i]);
                 }
-                f
+                l
             })
             .collect();
         let ring: Vec<[u32; 6]> = (0..nt)
@@ -317,7 +349,7 @@ impl<'a> State<'a> {
             table,
             cand_nb,
             closed,
-            cand_flags,
+            cand_local,
             vc_start,
             vc_list,
             alive: vec![true; nt],
@@ -345,6 +377,8 @@ impl<'a> State<'a> {
             quality: vec![0.0],
             log: Vec::new(),
             tree: Overlay::new(m, nv, ring),
+            forward: false,
+            initial: None,
             stamp: vec![0; nt],
             epoch: 0,
             queue: Default::default(),
@@ -527,8 +561,7 @@ impl<'a> State<'a> {
             for s in 0..self.nsearch {
                 for i in 0..self.cert_len[s] {
                     let t = self.queue[s][i];
-                    self.watch[t as usize].push((c, ver));
-                    self.log.push(Op::Watch(t));
+                    self.watch_push(t, c, ver);
                 }
             }
         }
@@ -546,6 +579,28 @@ impl<'a> State<'a> {
             self.split_pos[ci] = NONE;
             self.log.push(Op::SplitRem { c, pos: p });
         }
+    }
+
+    /// Adds `(c, ver)` to the watch list of triangle `t` (logged). In forward mode, where
+    /// nothing is undone, a list that doubled is first cleared of the entries of verdicts
+    /// since recomputed (those past the initial state's, which a reset brings back).
+    fn watch_push(&mut self, t: u32, c: u32, ver: u32) {
+        let list = &mut self.watch[t as usize];
+        if self.forward && list.len() >= 16 && list.len().is_power_of_two() {
+            let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]) as usize;
+            let verdict = &self.verdict;
+            let mut w = keep;
+            for r in keep..list.len() {
+                let (c2, v2) = list[r];
+                if verdict[c2 as usize].ver == v2 {
+                    list[w] = (c2, v2);
+                    w += 1;
+                }
+            }
+            list.truncate(w);
+        }
+        list.push((c, ver));
+        self.log.push(Op::Watch(t));
     }
 
     /// Moves triangle `t` from `P_old` to `P_new` (logged).
@@ -668,7 +723,12 @@ impl<'a> State<'a> {
         } else {
             self.check(c).kind == KIND_SPLIT
         };
-        self.log.push(Op::Apply(c));
+        if self.forward {
+            // Nothing will be undone: the log only serves the trees.
+            self.log.clear();
+        } else {
+            self.log.push(Op::Apply(c));
+        }
         self.changed.clear();
         if split {
             self.relabel_split(t0);
@@ -758,6 +818,7 @@ impl<'a> State<'a> {
     /// Reverts the last `apply`. Panics when nothing was applied.
     pub fn undo(&mut self) {
         assert!(!self.chosen.is_empty(), "undo with nothing applied");
+        assert!(!self.forward, "undo in forward mode");
         assert!(self.tree.is_empty(), "undo inside a look-ahead tree");
         while let Some(op) = self.log.pop() {
             if self.undo_shared(op) {
@@ -823,10 +884,76 @@ impl<'a> State<'a> {
 
     /// Reverts every action applied.
     pub fn reset(&mut self) {
-        while !self.chosen.is_empty() {
-            self.undo();
+        assert!(self.tree.is_empty(), "reset inside a look-ahead tree");
+        if self.forward {
+            self.restore_initial();
+        } else {
+            while !self.chosen.is_empty() {
+                self.undo();
+            }
         }
         self.base_cert.truncate(self.base_cert_init);
+    }
+
+    /// Forward mode (for runs, which never undo an applied action): `apply` keeps no undo
+    /// log (look-ahead trees still undo their pushes) and [`State::reset`] restores a copy
+    /// of the initial state instead of undoing every action. `undo` panics in this mode.
+    /// Only at the initial state.
+    pub fn set_forward(&mut self, on: bool) {
+        assert!(self.chosen.is_empty(), "set_forward with actions applied");
+        if on && self.initial.is_none() {
+            self.initial = Some(Box::new(Initial {
+                verdict: self.verdict.clone(),
+                count: self.count.clone(),
+                sets: self.sets.clone(),
+                polder: self.polder.clone(),
+                polder_size: self.polder_size.clone(),
+                dsu_parent: self.dsu_parent.clone(),
+                dsu_size: self.dsu_size.clone(),
+                split: self.split.clone(),
+                split_pos: self.split_pos.clone(),
+                watch_len: self.watch.iter().map(|w| w.len() as u32).collect(),
+                root_watch_len: self.root_watch.iter().map(|w| w.len() as u32).collect(),
+                ver: self.ver,
+            }));
+        }
+        self.forward = on;
+        self.log.clear();
+    }
+
+    /// Forward mode's reset: copies the initial state back.
+    fn restore_initial(&mut self) {
+        let init = self
+            .initial
+            .as_ref()
+            .expect("forward mode keeps the initial state");
+        self.verdict.copy_from_slice(&init.verdict);
+        self.count.copy_from_slice(&init.count);
+        self.sets.clone_from(&init.sets);
+        self.polder.copy_from_slice(&init.polder);
+        self.polder_size.clone_from(&init.polder_size);
+        self.dsu_parent.copy_from_slice(&init.dsu_parent);
+        self.dsu_size.copy_from_slice(&init.dsu_size);
+        self.split.clone_from(&init.split);
+        self.split_pos.copy_from_slice(&init.split_pos);
+        for (w, &n) in self.watch.iter_mut().zip(&init.watch_len) {
+            w.truncate(n as usize);
+        }
+        for (w, &n) in self.root_watch.iter_mut().zip(&init.root_watch_len) {
+            w.truncate(n as usize);
+        }
+        self.ver = init.ver;
+        for &c in &self.dirty_list {
+            self.dirty[c as usize] = false;
+        }
+        self.dirty_list.clear();
+        self.alive.iter_mut().for_each(|a| *a = true);
+        self.dead_count.iter_mut().for_each(|d| *d = 0);
+        self.stamp.iter_mut().for_each(|s| *s = 0);
+        self.remaining = self.alive.len() as u32;
+        self.chosen.clear();
+        self.quality.truncate(1);
+        self.log.clear();
     }
 
     /// Reverts the changes that base applies and tree pushes share (polders, dead

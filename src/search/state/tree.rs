@@ -55,7 +55,12 @@ pub(super) struct Overlay {
     path: Vec<u32>,
     serial: Vec<u32>,
     next_serial: u32,
+    /// Polder ids whose size changed parity at a split on the path, and how many there
+    /// were before each push.
+    changed: Vec<u32>,
+    changed_len: Vec<usize>,
     /// Scratch for `P_min` below the root.
+    affected_cands: Vec<u32>,
     affected: Vec<u32>,
     affected_mark: Vec<u32>,
     affected_epoch: u32,
@@ -83,6 +88,9 @@ impl Overlay {
             path: Vec::new(),
             serial: Vec::new(),
             next_serial: 0,
+            changed: Vec::new(),
+            changed_len: Vec::new(),
+            affected_cands: Vec::new(),
             affected: Vec::new(),
             affected_mark: vec![0; nt],
             affected_epoch: 0,
@@ -184,6 +192,11 @@ impl State<'_> {
             let tr = &self.tree;
             let t = if i < 4 * (d - 1) && parent_ok {
                 let (t, k, local) = tr.slots[at(d - 1) + i];
+                if t != NONE && !self.alive[t as usize] {
+                    // Used here, so 0 below too.
+                    self.tree.slots[start + i] = (t, 0, true);
+                    continue;
+                }
                 let keep = t == NONE
                     || (local
                         && tr.ring[t as usize]
@@ -279,12 +292,23 @@ impl State<'_> {
         let [t0, t1] = self.table.pairs[ci];
         let (_, kind) = self.tree_verdict(c);
         self.log.push(Op::TreeApply(c));
+        self.tree.changed_len.push(self.tree.changed.len());
         if kind == KIND_SPLIT {
             // The parts are needed to relabel them: search again (the smaller parts).
             let again = self.check(c);
             debug_assert_eq!(again.kind, KIND_SPLIT);
+            // Parities are relative to the root: a part of a polder whose parity already
+            // changed on the path has changed too, whatever this split does.
+            let p = self.polder[t0 as usize];
+            let inherited = self.tree.changed.contains(&p);
+            let first_new = self.polder_size.len() as u32;
             self.changed.clear();
             self.relabel_split(t0);
+            self.tree.changed.extend_from_slice(&self.changed);
+            if inherited {
+                let tr = &mut self.tree;
+                tr.changed.extend(first_new..self.polder_size.len() as u32);
+            }
         } else {
             let p = self.polder[t0 as usize];
             let old = self.polder_size[p as usize];
@@ -327,6 +351,8 @@ impl State<'_> {
             tr.shadowed.pop();
         }
         let c = tr.path.pop().expect("a pushed action");
+        let n = tr.changed_len.pop().expect("logged");
+        tr.changed.truncate(n);
         for v in self.table.quads[c as usize].into_iter().rev() {
             tr.touched_at[v as usize] = tr.touched_log.pop().expect("logged");
         }
@@ -423,9 +449,59 @@ impl State<'_> {
         lo
     }
 
-    /// Fills `tree.affected` with every remaining-or-used triangle whose number of allowed
-    /// actions may differ between the root and the current node (module docs).
+    /// Appends to `out` every candidate whose verdict may differ between the root and the
+    /// current node (some more than once; module docs): the actions of the path's
+    /// triangles, the candidates at the path's quad vertices, the base verdicts watching a
+    /// removed triangle or a merged dead component, and the base split verdicts when a
+    /// polder split on the path. Every other live candidate reads as at the root.
+    pub fn tree_affected(&self, out: &mut Vec<u32>) {
+        let table = self.table;
+        let tr = &self.tree;
+        for &c in &tr.path {
+            for x in table.pairs[c as usize] {
+                out.extend(
+                    table.by_triangle[x as usize]
+                        .iter()
+                        .filter(|&&c2| c2 != NONE),
+                );
+                for &(c2, ver) in &self.watch[x as usize] {
+                    if self.verdict[c2 as usize].ver == ver {
+                        out.push(c2);
+                    }
+                }
+            }
+            for v in table.quads[c as usize] {
+                let v = v as usize;
+                out.extend(&self.vc_list[self.vc_start[v] as usize..self.vc_start[v + 1] as usize]);
+            }
+        }
+        for op in &self.log[tr.log_start..] {
+            if let Op::Union { child, .. } = *op {
+                for &(c2, ver) in &self.root_watch[child as usize] {
+                    if self.verdict[c2 as usize].ver == ver {
+                        out.push(c2);
+                    }
+                }
+            }
+        }
+        // A split verdict reads differently only when its polder's parity changed, which
+        // takes a split on the path (otherwise every polder lost an even number).
+        if !tr.changed.is_empty() {
+            for &c2 in &self.split {
+                let t0 = table.pairs[c2 as usize][0];
+                if self.is_live(c2) && tr.changed.contains(&self.polder[t0 as usize]) {
+                    out.push(c2);
+                }
+            }
+        }
+    }
+
+    /// Fills `tree.affected` with the triangles of every candidate of [`State::tree_affected`]
+    /// (each once): those whose number of allowed actions may differ from the root's.
     fn collect_affected(&mut self) {
+        let mut cands = std::mem::take(&mut self.tree.affected_cands);
+        cands.clear();
+        self.tree_affected(&mut cands);
         let tr = &mut self.tree;
         tr.affected.clear();
         tr.affected_epoch = tr.affected_epoch.wrapping_add(1);
@@ -434,60 +510,14 @@ impl State<'_> {
             tr.affected_epoch = 1;
         }
         let epoch = tr.affected_epoch;
-        let table = self.table;
-        let add_pair = |tr: &mut Overlay, c: u32| {
-            for t in table.pairs[c as usize] {
+        for &c in &cands {
+            for t in self.table.pairs[c as usize] {
                 if tr.affected_mark[t as usize] != epoch {
                     tr.affected_mark[t as usize] = epoch;
                     tr.affected.push(t);
                 }
             }
-        };
-        for i in 0..tr.path.len() {
-            let c = tr.path[i];
-            for x in table.pairs[c as usize] {
-                for c2 in table.by_triangle[x as usize] {
-                    if c2 != NONE {
-                        add_pair(tr, c2);
-                    }
-                }
-                for &(c2, ver) in &self.watch[x as usize] {
-                    if self.verdict[c2 as usize].ver == ver {
-                        add_pair(tr, c2);
-                    }
-                }
-            }
-            for v in table.quads[c as usize] {
-                let v = v as usize;
-                for j in self.vc_start[v]..self.vc_start[v + 1] {
-                    add_pair(tr, self.vc_list[j as usize]);
-                }
-            }
         }
-        // Without a split on the path every polder lost an even number of triangles, so
-        // no polder parity changed and the base split verdicts still read the same.
-        let mut split_on_path = false;
-        for op in &self.log[tr.log_start..] {
-            match *op {
-                Op::Union { child, .. } => {
-                    for &(c2, ver) in &self.root_watch[child as usize] {
-                        if self.verdict[c2 as usize].ver == ver {
-                            add_pair(tr, c2);
-                        }
-                    }
-                }
-                Op::PolderNew => split_on_path = true,
-                _ => {}
-            }
-        }
-        if split_on_path {
-            for &c2 in &self.split {
-                if self.alive[table.pairs[c2 as usize][0] as usize]
-                    && self.alive[table.pairs[c2 as usize][1] as usize]
-                {
-                    add_pair(tr, c2);
-                }
-            }
-        }
+        tr.affected_cands = cands;
     }
 }

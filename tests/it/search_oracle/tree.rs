@@ -199,7 +199,9 @@ fn tree_layer_matches_oracle() {
         }
     }
     for (name, mesh) in sample_meshes(SEED ^ 0x7E3) {
-        queries += tree_walk(&name, &mesh, SEED, 8).unwrap_or_else(|e| panic!("{e}"));
+        for s in 0..2 {
+            queries += tree_walk(&name, &mesh, SEED ^ s, 8).unwrap_or_else(|e| panic!("{e}"));
+        }
     }
     let mut spec = Grid::plain(8, 7);
     spec.jitter = 0.2;
