@@ -82,8 +82,8 @@ enum Op {
     Apply(u32),
     /// Start of a `tree_push(c)`: undone last by `tree_pop`, revives the pair.
     TreeApply(u32),
-    /// Previous verdict of candidate `c`.
-    Verdict { c: u32, old: Verdict },
+    /// Previous verdict of candidate `c` and its version.
+    Verdict { c: u32, old: Verdict, ver: u32 },
     /// Triangle `t` had `old` allowed actions.
     Count { t: u32, old: u8 },
     /// Triangle `t` was in polder `old`.
@@ -127,14 +127,13 @@ struct Verdict {
     /// `KIND_DISTINCT`, triangles for `KIND_MET` / `KIND_SPLIT`.
     cert: u32,
     cert_len: u32,
-    /// Version the watch lists refer to (base verdicts).
-    ver: u32,
 }
 
 /// What forward mode resets to (see [`State::set_forward`]).
 #[derive(Debug, Clone)]
 struct Initial {
     verdict: Vec<Verdict>,
+    cert_ver: Vec<u32>,
     count: Vec<u8>,
     sets: OrderedSets,
     polder: Vec<u32>,
@@ -169,6 +168,9 @@ pub struct State<'a> {
     count: Vec<u8>,
     sets: OrderedSets,
     verdict: Vec<Verdict>,
+    /// Version of each base verdict, which the watch lists refer to (kept apart: read for
+    /// every watch entry).
+    cert_ver: Vec<u32>,
     /// Certificates of the base verdicts (append-only; cut back to the initial verdicts'
     /// when the state is reset).
     base_cert: Vec<u32>,
@@ -357,6 +359,7 @@ impl<'a> State<'a> {
             count: vec![0; nt],
             sets: OrderedSets::new(nt),
             verdict: vec![Verdict::default(); m],
+            cert_ver: vec![0; m],
             base_cert: Vec::new(),
             base_cert_init: 0,
             ver: 0,
@@ -538,10 +541,14 @@ impl<'a> State<'a> {
         {
             return;
         }
-        self.log.push(Op::Verdict { c, old });
+        self.log.push(Op::Verdict {
+            c,
+            old,
+            ver: self.cert_ver[ci],
+        });
         self.ver = self.ver.wrapping_add(1);
         let ver = self.ver;
-        r.ver = ver;
+        self.cert_ver[ci] = ver;
         (r.cert, r.cert_len) = self.append_cert(r.kind, false);
         self.verdict[ci] = r;
         if r.allowed != old.allowed {
@@ -588,11 +595,11 @@ impl<'a> State<'a> {
         let list = &mut self.watch[t as usize];
         if self.forward && list.len() >= 16 && list.len().is_power_of_two() {
             let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]) as usize;
-            let verdict = &self.verdict;
+            let cert_ver = &self.cert_ver;
             let mut w = keep;
             for r in keep..list.len() {
                 let (c2, v2) = list[r];
-                if verdict[c2 as usize].ver == v2 {
+                if cert_ver[c2 as usize] == v2 {
                     list[w] = (c2, v2);
                     w += 1;
                 }
@@ -630,6 +637,7 @@ impl<'a> State<'a> {
         self.log.push(Op::Verdict {
             c,
             old: self.verdict[ci],
+            ver: self.cert_ver[ci],
         });
         self.verdict[ci].allowed = false;
     }
@@ -777,7 +785,7 @@ impl<'a> State<'a> {
             if let Some(child) = self.union(qv[0], qv[i]) {
                 for j in 0..self.root_watch[child as usize].len() {
                     let (c2, ver) = self.root_watch[child as usize][j];
-                    if self.verdict[c2 as usize].ver == ver && self.is_live(c2) {
+                    if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
                         self.mark(c2);
                     }
                 }
@@ -796,7 +804,7 @@ impl<'a> State<'a> {
             // Marking touches no watch list: iterate the list taken out, then put it back.
             let list = std::mem::take(&mut self.watch[x as usize]);
             for &(c2, ver) in &list {
-                if self.verdict[c2 as usize].ver == ver && self.is_live(c2) {
+                if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
                     self.mark(c2);
                 }
             }
@@ -839,7 +847,10 @@ impl<'a> State<'a> {
                     self.quality.pop();
                     return;
                 }
-                Op::Verdict { c, old } => self.verdict[c as usize] = old,
+                Op::Verdict { c, old, ver } => {
+                    self.verdict[c as usize] = old;
+                    self.cert_ver[c as usize] = ver;
+                }
                 Op::Count { t, old } => {
                     let cur = self.count[t as usize];
                     self.move_count(t, cur, old);
@@ -904,6 +915,7 @@ impl<'a> State<'a> {
         if on && self.initial.is_none() {
             self.initial = Some(Box::new(Initial {
                 verdict: self.verdict.clone(),
+                cert_ver: self.cert_ver.clone(),
                 count: self.count.clone(),
                 sets: self.sets.clone(),
                 polder: self.polder.clone(),
@@ -928,6 +940,7 @@ impl<'a> State<'a> {
             .as_ref()
             .expect("forward mode keeps the initial state");
         self.verdict.copy_from_slice(&init.verdict);
+        self.cert_ver.copy_from_slice(&init.cert_ver);
         self.count.copy_from_slice(&init.count);
         self.sets.clone_from(&init.sets);
         self.polder.copy_from_slice(&init.polder);

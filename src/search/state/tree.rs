@@ -26,16 +26,22 @@ use super::check::LOCAL_PROOF;
 use super::{DEAD, KIND_LOCAL, KIND_SPLIT, Op, State, Verdict};
 use crate::mesh::NONE;
 
+/// A verdict computed inside the tree, with the depth and serial number of its node.
+#[derive(Debug, Clone, Copy, Default)]
+struct Cached {
+    verdict: Verdict,
+    depth: u32,
+    serial: u32,
+}
+
 /// The tree's side of the state: its path, its verdict cache and scratch.
 #[derive(Debug, Clone)]
 pub(super) struct Overlay {
     /// Verdicts computed inside the tree, with the node they were computed at.
-    verdict: Vec<Verdict>,
-    serial_of: Vec<u32>,
-    depth_of: Vec<u32>,
+    cached: Vec<Cached>,
     /// Ancestors' verdicts overwritten below them, restored when the node is popped:
-    /// `(depth of the overwriting node, candidate, verdict, its depth, its serial)`.
-    shadowed: Vec<(u32, u32, Verdict, u32, u32)>,
+    /// `(depth of the overwriting node, candidate, the entry)`.
+    shadowed: Vec<(u32, u32, Cached)>,
     /// The counts of the triangles across the sides of the path's quads (`tree_near`), per
     /// depth d a segment of 4·d slots at offset 2·d·(d-1): triangle (or NONE), its count,
     /// and whether every action it has was dead or allowed by the local proof.
@@ -80,9 +86,7 @@ impl Overlay {
             touched_at: vec![0; nv],
             touched_log: Vec::new(),
             ring,
-            verdict: vec![Verdict::default(); m],
-            serial_of: vec![0; m],
-            depth_of: vec![0; m],
+            cached: vec![Cached::default(); m],
             shadowed: Vec::new(),
             cert: Vec::new(),
             path: Vec::new(),
@@ -116,7 +120,7 @@ impl State<'_> {
         let tr = &mut self.tree;
         if tr.next_serial >= u32::MAX - (1 << 20) {
             // Serial numbers are about to wrap: forget every cached verdict.
-            tr.serial_of.iter_mut().for_each(|s| *s = 0);
+            tr.cached.iter_mut().for_each(|e| e.serial = 0);
             tr.slots_serial.iter_mut().for_each(|s| *s = 0);
             tr.touched_at.iter_mut().for_each(|s| *s = 0);
             tr.next_serial = 0;
@@ -255,10 +259,11 @@ impl State<'_> {
         if mask & LOCAL_PROOF != 0 {
             return (true, KIND_LOCAL);
         }
-        let od = tr.depth_of[ci] as usize;
-        let ancestor = od <= d && tr.serial[od] == tr.serial_of[ci];
+        let e = tr.cached[ci];
+        let od = e.depth as usize;
+        let ancestor = od <= d && tr.serial[od] == e.serial;
         if ancestor {
-            let v = tr.verdict[ci];
+            let v = e.verdict;
             if let Some(a) = self.still_holds(c, &v, &tr.cert) {
                 return (a, v.kind);
             }
@@ -273,12 +278,14 @@ impl State<'_> {
         (v.cert, v.cert_len) = self.append_cert(v.kind, true);
         let tr = &mut self.tree;
         if ancestor && od < d {
-            let old = (d as u32, c, tr.verdict[ci], od as u32, tr.serial_of[ci]);
+            let old = (d as u32, c, e);
             tr.shadowed.push(old);
         }
-        tr.verdict[ci] = v;
-        tr.depth_of[ci] = d as u32;
-        tr.serial_of[ci] = tr.serial[d];
+        tr.cached[ci] = Cached {
+            verdict: v,
+            depth: d as u32,
+            serial: tr.serial[d],
+        };
         (v.allowed, v.kind)
     }
 
@@ -342,12 +349,12 @@ impl State<'_> {
         assert!(!self.tree.is_empty(), "tree_pop with nothing pushed");
         let tr = &mut self.tree;
         let d = tr.path.len() as u32;
-        while let Some(&(at, c, v, od, serial)) = tr.shadowed.last() {
+        while let Some(&(at, c, e)) = tr.shadowed.last() {
             if at < d {
                 break;
             }
             let ci = c as usize;
-            (tr.verdict[ci], tr.depth_of[ci], tr.serial_of[ci]) = (v, od, serial);
+            tr.cached[ci] = e;
             tr.shadowed.pop();
         }
         let c = tr.path.pop().expect("a pushed action");
@@ -465,7 +472,7 @@ impl State<'_> {
                         .filter(|&&c2| c2 != NONE),
                 );
                 for &(c2, ver) in &self.watch[x as usize] {
-                    if self.verdict[c2 as usize].ver == ver {
+                    if self.cert_ver[c2 as usize] == ver {
                         out.push(c2);
                     }
                 }
@@ -478,7 +485,7 @@ impl State<'_> {
         for op in &self.log[tr.log_start..] {
             if let Op::Union { child, .. } = *op {
                 for &(c2, ver) in &self.root_watch[child as usize] {
-                    if self.verdict[c2 as usize].ver == ver {
+                    if self.cert_ver[c2 as usize] == ver {
                         out.push(c2);
                     }
                 }
