@@ -264,7 +264,7 @@ impl Searcher<'_> {
         self.near.clear();
         let mut kmin = u8::MAX;
         for &(n, k, _) in self.state.tree_near() {
-            if n == NONE || k == 0 || k > kmin {
+            if k == 0 || k > kmin {
                 continue;
             }
             if k < kmin {

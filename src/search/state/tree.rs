@@ -42,11 +42,12 @@ pub(super) struct Overlay {
     /// Ancestors' verdicts overwritten below them, restored when the node is popped:
     /// `(depth of the overwriting node, candidate, the entry)`.
     shadowed: Vec<(u32, u32, Cached)>,
-    /// The counts of the triangles across the sides of the path's quads (`tree_near`), per
-    /// depth d a segment of 4·d slots at offset 2·d·(d-1): triangle (or NONE), its count,
-    /// and whether every action it has was dead or allowed by the local proof.
+    /// `tree_near`'s lists, a stack with one list per depth (depth d: from `slots_end[d-1]`
+    /// to `slots_end[d]`; `slots_end[0] == 0`): triangle, its count, and whether each of
+    /// its actions was dead or allowed by the local proof.
     slots: Vec<(u32, u8, bool)>,
-    /// Serial number of the node each depth's segment was computed at.
+    slots_end: Vec<usize>,
+    /// Serial number of the node each depth's list was computed at.
     slots_serial: Vec<u32>,
     /// Per vertex: serial number of the deepest node of the current path whose push used a
     /// triangle around it (restored on pop from `touched_log`).
@@ -82,6 +83,7 @@ impl Overlay {
         let nt = ring.len();
         Overlay {
             slots: Vec::new(),
+            slots_end: vec![0],
             slots_serial: Vec::new(),
             touched_at: vec![0; nv],
             touched_log: Vec::new(),
@@ -168,62 +170,74 @@ impl State<'_> {
         k
     }
 
-    /// The triangles across the four sides of each quad of the path (root first, sides in
-    /// quad order; NONE where there is none) with their number of allowed actions at the
-    /// current node (0 when used). Incremental: a slot of the parent node is kept when all
-    /// its triangle's actions were dead or allowed by the local proof there and the last
-    /// push used no triangle around any vertex of those actions' quads.
+    /// The remaining triangles across the sides of the path's quads (root first, sides in
+    /// quad order; a triangle next to two quads appears twice) with their number of allowed
+    /// actions at the current node and whether each of their actions is dead or allowed by
+    /// the local proof. Incremental: the parent node's list minus the triangles the last
+    /// push used, each kept as it was when all its actions were dead or local there and the
+    /// push used no triangle around any vertex of their quads, then the last quad's sides.
     pub fn tree_near(&mut self) -> &[(u32, u8, bool)] {
         let d = self.tree.path.len();
-        let at = |d: usize| 2 * d * d.saturating_sub(1);
-        let (start, end) = (at(d), at(d) + 4 * d);
         if d == 0 {
             return &[];
         }
+        {
+            let tr = &mut self.tree;
+            if tr.slots_serial.len() <= d {
+                tr.slots_serial.resize(d + 1, 0);
+            }
+            if tr.slots_end.len() <= d {
+                tr.slots_end.resize(d + 1, 0);
+            }
+        }
+        let here = self.tree.serial[d];
+        if self.tree.slots_serial[d] == here {
+            let (lo, hi) = (self.tree.slots_end[d - 1], self.tree.slots_end[d]);
+            return &self.tree.slots[lo..hi];
+        }
         let tr = &mut self.tree;
-        if tr.slots.len() < end {
-            tr.slots.resize(end, (NONE, 0, true));
-        }
-        if tr.slots_serial.len() <= d {
-            tr.slots_serial.resize(d + 1, 0);
-        }
-        let here = tr.serial[d];
-        if tr.slots_serial[d] == here {
-            return &self.tree.slots[start..end];
-        }
-        let parent_ok = d >= 2 && tr.slots_serial[d - 1] == tr.serial[d - 1];
-        for i in 0..4 * d {
-            let tr = &self.tree;
-            let t = if i < 4 * (d - 1) && parent_ok {
-                let (t, k, local) = tr.slots[at(d - 1) + i];
-                if t != NONE && !self.alive[t as usize] {
-                    // Used here, so 0 below too.
-                    self.tree.slots[start + i] = (t, 0, true);
+        let from = if d >= 2 && tr.slots_serial[d - 1] == tr.serial[d - 1] {
+            // The parent's list is the last one kept: start from it.
+            let (lo, hi) = (tr.slots_end[d - 2], tr.slots_end[d - 1]);
+            tr.slots.truncate(hi);
+            for i in lo..hi {
+                let tr = &self.tree;
+                let (t, k, local) = tr.slots[i];
+                if !self.alive[t as usize] {
                     continue;
                 }
-                let keep = t == NONE
-                    || (local
-                        && tr.ring[t as usize]
-                            .iter()
-                            .all(|&v| v == NONE || tr.touched_at[v as usize] != here));
-                if keep {
-                    self.tree.slots[start + i] = (t, k, local);
-                    continue;
+                let keep = local
+                    && tr.ring[t as usize]
+                        .iter()
+                        .all(|&v| v == NONE || tr.touched_at[v as usize] != here);
+                let slot = if keep {
+                    (t, k, local)
+                } else {
+                    let (k, local) = self.count_local(t);
+                    (t, k as u8, local)
+                };
+                self.tree.slots.push(slot);
+            }
+            d - 1
+        } else {
+            // Built from the whole path, as the only list kept.
+            tr.slots.clear();
+            tr.slots_end[d - 1] = 0;
+            0
+        };
+        let start = self.tree.slots_end[d - 1];
+        for i in from..d {
+            for t in self.cand_nb[self.tree.path[i] as usize] {
+                if t != NONE && self.alive[t as usize] {
+                    let (k, local) = self.count_local(t);
+                    self.tree.slots.push((t, k as u8, local));
                 }
-                t
-            } else {
-                self.cand_nb[tr.path[i / 4] as usize][i % 4]
-            };
-            let slot = if t == NONE {
-                (NONE, 0, true)
-            } else {
-                let (k, local) = self.count_local(t);
-                (t, k as u8, local)
-            };
-            self.tree.slots[start + i] = slot;
+            }
         }
-        self.tree.slots_serial[d] = here;
-        &self.tree.slots[start..end]
+        let tr = &mut self.tree;
+        tr.slots_end[d] = tr.slots.len();
+        tr.slots_serial[d] = here;
+        &tr.slots[start..]
     }
 
     /// Allowed actions of `t` at the current node, and whether each of its actions is dead

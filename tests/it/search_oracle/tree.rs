@@ -86,10 +86,8 @@ fn check_node(
     let expected: Vec<(u32, u8)> = tree_path
         .iter()
         .flat_map(|&c| state.quad_neighbours(c))
-        .map(|n| match n {
-            NONE => (NONE, 0),
-            n => (n, naive_count(oracle, table, n) as u8),
-        })
+        .filter(|&n| n != NONE && oracle.is_remaining(n))
+        .map(|n| (n, naive_count(oracle, table, n) as u8))
         .collect();
     let got: Vec<(u32, u8)> = slots.iter().map(|&(t, k, _)| (t, k)).collect();
     queries += 1;
