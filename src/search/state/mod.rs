@@ -534,14 +534,12 @@ impl<'a> State<'a> {
         let mut r = self.check(c);
         let ci = c as usize;
         let old = self.verdict[ci];
-        if r.kind == KIND_LOCAL
-            && old.kind == KIND_LOCAL
-            && r.allowed == old.allowed
-            && r.mask == old.mask
-        {
+        // A verdict of the local kind is never read back through its mask (the trees
+        // recompute the local proof first), so a new mask alone is not a change.
+        if r.kind == KIND_LOCAL && old.kind == KIND_LOCAL && r.allowed == old.allowed {
             return;
         }
-        self.log.push(Op::Verdict {
+        self.base_log(Op::Verdict {
             c,
             old,
             ver: self.cert_ver[ci],
@@ -562,7 +560,7 @@ impl<'a> State<'a> {
             for i in 0..self.narcs {
                 let root = self.arc_roots[i];
                 self.root_watch[root as usize].push((c, ver));
-                self.log.push(Op::RootWatch(root));
+                self.base_log(Op::RootWatch(root));
             }
         } else if r.kind != KIND_LOCAL {
             for s in 0..self.nsearch {
@@ -576,7 +574,7 @@ impl<'a> State<'a> {
         if r.kind == KIND_SPLIT && !in_split {
             self.split_pos[ci] = self.split.len() as u32;
             self.split.push(c);
-            self.log.push(Op::SplitIns);
+            self.base_log(Op::SplitIns);
         } else if r.kind != KIND_SPLIT && in_split {
             let p = self.split_pos[ci];
             self.split.swap_remove(p as usize);
@@ -584,7 +582,16 @@ impl<'a> State<'a> {
                 self.split_pos[y as usize] = p;
             }
             self.split_pos[ci] = NONE;
-            self.log.push(Op::SplitRem { c, pos: p });
+            self.base_log(Op::SplitRem { c, pos: p });
+        }
+    }
+
+    /// Logs a change of the base state for `undo`; forward mode undoes nothing and keeps
+    /// no log.
+    #[inline]
+    fn base_log(&mut self, op: Op) {
+        if !self.forward {
+            self.log.push(op);
         }
     }
 
@@ -607,7 +614,7 @@ impl<'a> State<'a> {
             list.truncate(w);
         }
         list.push((c, ver));
-        self.log.push(Op::Watch(t));
+        self.base_log(Op::Watch(t));
     }
 
     /// Moves triangle `t` from `P_old` to `P_new` (logged).
@@ -617,7 +624,7 @@ impl<'a> State<'a> {
             return;
         }
         self.move_count(t, old, new);
-        self.log.push(Op::Count { t, old });
+        self.base_log(Op::Count { t, old });
     }
 
     /// Sets the count of `t` from `old` to `new` and moves it between the sets.
@@ -634,7 +641,7 @@ impl<'a> State<'a> {
 
     fn set_verdict_dead(&mut self, c: u32) {
         let ci = c as usize;
-        self.log.push(Op::Verdict {
+        self.base_log(Op::Verdict {
             c,
             old: self.verdict[ci],
             ver: self.cert_ver[ci],
@@ -648,7 +655,7 @@ impl<'a> State<'a> {
         if !self.dirty[ci] {
             self.dirty[ci] = true;
             self.dirty_list.push(c);
-            self.log.push(Op::Dirty);
+            self.base_log(Op::Dirty);
         }
     }
 
@@ -665,13 +672,13 @@ impl<'a> State<'a> {
             self.recheck_one(c);
         }
         self.dirty[c as usize] = false;
-        self.log.push(Op::Clean(c));
+        self.base_log(Op::Clean(c));
     }
 
     /// Makes every verdict exact.
     pub fn resolve_all(&mut self) {
         while let Some(c) = self.dirty_list.pop() {
-            self.log.push(Op::DirtyPop(c));
+            self.base_log(Op::DirtyPop(c));
             if self.dirty[c as usize] {
                 self.resolve_slow(c);
             }
@@ -743,7 +750,7 @@ impl<'a> State<'a> {
         } else {
             let p = self.polder[t0 as usize];
             let psize = self.polder_size[p as usize];
-            self.log.push(Op::PolderSize { p, old: psize });
+            self.base_log(Op::PolderSize { p, old: psize });
             self.polder_size[p as usize] = psize - 2;
         }
         // Remove the pair.
