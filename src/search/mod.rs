@@ -155,6 +155,8 @@ pub struct Searcher<'a> {
     /// Uniform tree: ranks of the actions allowed at the root; per depth, the ranks the
     /// path may have allowed.
     allowed_ranks: Vec<u32>,
+    /// Position in `order` up to which `allowed_ranks` is built.
+    allowed_scan: usize,
     extra: Vec<Vec<u32>>,
 }
 
@@ -184,6 +186,7 @@ impl<'a> Searcher<'a> {
             nodes: 0,
             near: Vec::new(),
             allowed_ranks: Vec::new(),
+            allowed_scan: 0,
             extra: Vec::new(),
             used: vec![false; mesh.num_triangles()],
         }

@@ -92,6 +92,13 @@ impl Searcher<'_> {
 
     /// Uniform look-ahead tree of horizon `h` with exact branch and bound.
     pub(super) fn uniform(&mut self, h: u32) {
+        if h == 1 {
+            // The best sequence of one action is the best allowed action: greedy, which
+            // keeps the base state lazy (the tree would resolve every verdict each step).
+            self.greedy();
+            self.nodes += self.state.quads() as u64;
+            return;
+        }
         loop {
             self.advance_cursor();
             if self.cursor == self.order.len() {
@@ -103,17 +110,30 @@ impl Searcher<'_> {
             let mut first = NONE;
             self.state.tree_begin();
             self.allowed_ranks.clear();
-            for r in self.cursor..self.order.len() {
-                if self.state.is_allowed(self.order[r]) {
-                    self.allowed_ranks.push(r as u32);
-                }
-            }
+            self.allowed_scan = self.cursor;
             self.uniform_dfs(0, h, 0.0, top, NONE, &mut best, &mut first);
             if first == NONE {
                 break;
             }
             self.state.apply(first);
         }
+    }
+
+    /// The rank of the `i`-th action allowed at the root of the current uniform tree (from
+    /// the cursor), or `u32::MAX` past the last; found lazily (the root's verdicts stay
+    /// readable inside the tree).
+    fn allowed_rank(&mut self, i: usize) -> u32 {
+        while self.allowed_ranks.len() <= i {
+            if self.allowed_scan >= self.order.len() {
+                return u32::MAX;
+            }
+            let r = self.allowed_scan;
+            self.allowed_scan += 1;
+            if self.state.is_allowed(self.order[r]) {
+                self.allowed_ranks.push(r as u32);
+            }
+        }
+        self.allowed_ranks[i]
     }
 
     /// Explores the node at depth `d` (partial reward `partial`, first action `root`);
@@ -153,7 +173,7 @@ impl Searcher<'_> {
         }
         let (mut i, mut j) = (0, 0);
         loop {
-            let a = self.allowed_ranks.get(i).copied().unwrap_or(u32::MAX);
+            let a = self.allowed_rank(i);
             let b = extra.get(j).copied().unwrap_or(u32::MAX);
             if a == u32::MAX && b == u32::MAX {
                 break;
