@@ -6,6 +6,7 @@ mod error;
 pub mod generate;
 mod load;
 pub mod msh;
+pub mod order;
 mod topology;
 pub mod vtu;
 
