@@ -167,6 +167,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             triangles: n,
             ..GridSpec::default()
         });
+        // As `generate grid` then `mesh::load` would give it: in spatial order.
+        let mut data = mesh::MeshData {
+            vertices: g.vertices.clone(),
+            triangles: g.triangles.clone(),
+            ..Default::default()
+        };
+        mesh::order::spatial(&mut data);
+        let g = mesh::Mesh::new(data)?;
         let gt = CandidateTable::build(&g);
         let mut s = Searcher::new(&g, &gt);
         let runs = if n >= 1_000_000 {
