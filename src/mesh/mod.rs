@@ -62,6 +62,29 @@ pub struct MeshData {
     pub quad_surface: Vec<i32>,
 }
 
+impl MeshData {
+    /// Fills the tags and surfaces left empty with what empty means: nodes and triangles
+    /// numbered from 1, quads numbered after the triangles, everything on surface 1.
+    pub fn materialise_defaults(&mut self) {
+        let (nv, nt, nq) = (self.vertices.len(), self.triangles.len(), self.quads.len());
+        if self.vertex_ids.is_empty() {
+            self.vertex_ids = (1..=nv as u64).collect();
+        }
+        if self.triangle_ids.is_empty() {
+            self.triangle_ids = (1..=nt as u64).collect();
+        }
+        if self.triangle_surface.is_empty() {
+            self.triangle_surface = vec![1; nt];
+        }
+        if self.quad_ids.is_empty() {
+            self.quad_ids = (nt as u64 + 1..=(nt + nq) as u64).collect();
+        }
+        if self.quad_surface.is_empty() {
+            self.quad_surface = vec![1; nq];
+        }
+    }
+}
+
 impl Mesh {
     /// Validates `data` and builds the mesh: finite coordinates, node indices in range, no
     /// repeated node in an element, no zero-area or duplicate triangle, no edge shared by more

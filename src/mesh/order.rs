@@ -14,19 +14,8 @@ pub fn spatial(data: &mut MeshData) {
     if nt < 2 {
         return;
     }
-    // Materialise implicit tags before anything moves.
-    if data.vertex_ids.is_empty() {
-        data.vertex_ids = (1..=nv as u64).collect();
-    }
-    if data.triangle_ids.is_empty() {
-        data.triangle_ids = (1..=nt as u64).collect();
-    }
-    if data.triangle_surface.is_empty() {
-        data.triangle_surface = vec![1; nt];
-    }
-    if data.quad_ids.is_empty() && !data.quads.is_empty() {
-        data.quad_ids = (nt as u64 + 1..=(nt + data.quads.len()) as u64).collect();
-    }
+    // Implicit tags are positions: fix them before anything moves.
+    data.materialise_defaults();
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for v in &data.vertices {
         for k in 0..3 {

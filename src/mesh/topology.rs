@@ -53,21 +53,7 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             triangles: nt,
         });
     }
-    if data.vertex_ids.is_empty() {
-        data.vertex_ids = (1..=nv as u64).collect();
-    }
-    if data.triangle_ids.is_empty() {
-        data.triangle_ids = (1..=nt as u64).collect();
-    }
-    if data.triangle_surface.is_empty() {
-        data.triangle_surface = vec![1; nt];
-    }
-    if data.quad_ids.is_empty() {
-        data.quad_ids = (nt as u64 + 1..=(nt + data.quads.len()) as u64).collect();
-    }
-    if data.quad_surface.is_empty() {
-        data.quad_surface = vec![1; data.quads.len()];
-    }
+    data.materialise_defaults();
     assert_eq!(data.vertex_ids.len(), nv, "one id per vertex");
     assert_eq!(data.triangle_ids.len(), nt, "one id per triangle");
     assert_eq!(data.triangle_surface.len(), nt, "one surface per triangle");

@@ -235,15 +235,7 @@ impl State<'_> {
             // Groups and how many are still running.
             let mut groups = 0;
             let mut running = 0;
-            let mut gsize = [0u32; 4];
-            let mut gdone = [true; 4];
-            for s in 0..ns {
-                let g = self.group[s] as usize;
-                gsize[g] += self.queue[s].len() as u32;
-                if self.head[s] < self.queue[s].len() {
-                    gdone[g] = false;
-                }
-            }
+            let (gsize, gdone) = self.group_parts(ns);
             for s in 0..ns {
                 if self.group[s] as usize == s {
                     groups += 1;
@@ -295,6 +287,22 @@ impl State<'_> {
                 };
             }
         }
+    }
+
+    /// Per group (indexed by its root search) of the current searches: triangles visited,
+    /// and whether every search of the group has finished.
+    #[inline]
+    fn group_parts(&self, ns: usize) -> ([u32; 4], [bool; 4]) {
+        let mut gsize = [0u32; 4];
+        let mut gdone = [true; 4];
+        for s in 0..ns {
+            let g = self.group[s] as usize;
+            gsize[g] += self.queue[s].len() as u32;
+            if self.head[s] < self.queue[s].len() {
+                gdone[g] = false;
+            }
+        }
+        (gsize, gdone)
     }
 
     /// Appends the certificate of the last [`State::check`] (of a verdict of kind `kind`)
@@ -399,15 +407,7 @@ impl State<'_> {
         let ns = self.nsearch;
         // Whole parts found: each finished group; keep the old id for the running one, or
         // for the largest when all finished.
-        let mut gsize = [0u32; 4];
-        let mut gdone = [true; 4];
-        for s in 0..ns {
-            let g = self.group[s] as usize;
-            gsize[g] += self.queue[s].len() as u32;
-            if self.head[s] < self.queue[s].len() {
-                gdone[g] = false;
-            }
-        }
+        let (gsize, gdone) = self.group_parts(ns);
         let mut keep = usize::MAX;
         for g in 0..ns {
             if self.group[g] as usize == g && !gdone[g] {
