@@ -1,4 +1,4 @@
-//! The state's lazy mode (as the trees use it: `apply_lazy` marks verdicts that may have
+//! The state's lazy mode (as greedy uses it: `apply_lazy` marks verdicts that may have
 //! changed, queries recheck what they touch, `resolve_all` makes everything exact) against the
 //! naive oracle: partial queries after every lazy apply and undo, full comparison at decisions.
 
