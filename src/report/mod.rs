@@ -337,6 +337,17 @@ fn family_blocks(doc: &mut Document, families: &[Family]) {
 }
 
 /// The paper's numbers beside ours, for meshes the paper has a case for.
+/// The tree algorithms among `configs` (those with a horizon), each once, in order.
+fn tree_algos<'c>(configs: &[(&'c Config, &[Run])]) -> Vec<&'c str> {
+    let mut algos: Vec<&str> = configs
+        .iter()
+        .filter(|(c, _)| c.horizon.is_some())
+        .map(|(c, _)| c.algo.as_str())
+        .collect();
+    algos.dedup();
+    algos
+}
+
 fn paper_beside(doc: &mut Document, mesh: &str, configs: &[(&Config, &[Run])]) {
     let Some(case) = paper::case_for(mesh) else {
         return;
@@ -406,12 +417,7 @@ fn box_plots(
     mesh: &str,
     configs: &[(&Config, &[Run])],
 ) -> Result<(), ReportError> {
-    let mut algos: Vec<&str> = configs
-        .iter()
-        .filter(|(c, _)| c.horizon.is_some())
-        .map(|(c, _)| c.algo.as_str())
-        .collect();
-    algos.dedup();
+    let algos = tree_algos(configs);
     if algos.is_empty() {
         return Ok(());
     }
@@ -502,12 +508,7 @@ fn picture_choice<'a>(
             .collect();
     }
     let mut out: Vec<(&Config, &[Run])> = Vec::new();
-    let mut algos: Vec<&str> = configs
-        .iter()
-        .filter(|(c, _)| c.horizon.is_some())
-        .map(|(c, _)| c.algo.as_str())
-        .collect();
-    algos.dedup();
+    let algos = tree_algos(configs);
     for algo in algos {
         // The best median quality; the smallest horizon among equals (the cheapest to re-run).
         let mut best: Option<(&Config, &[Run], f64)> = None;

@@ -66,13 +66,7 @@ pub fn mann_whitney(x: &[f64], y: &[f64]) -> MannWhitney {
         };
     }
     let n = n1f + n2f;
-    let tie_term: f64 = tie_sizes
-        .iter()
-        .map(|&t| {
-            let t = t as f64;
-            t * t * t - t
-        })
-        .sum();
+    let tie_term = tie_correction(&tie_sizes);
     let var = n1f * n2f / 12.0 * ((n + 1.0) - tie_term / (n * (n - 1.0)));
     let p = if var <= 0.0 {
         // Every value equal: no evidence of a difference.
@@ -89,6 +83,17 @@ pub fn mann_whitney(x: &[f64], y: &[f64]) -> MannWhitney {
 }
 
 /// Average ranks (1-based) of `values` in their given order, and the sizes of the tie groups.
+/// The ties' term of a rank test's variance: the sum of `t^3 - t` over tie group sizes.
+fn tie_correction(sizes: &[usize]) -> f64 {
+    sizes
+        .iter()
+        .map(|&t| {
+            let t = t as f64;
+            t * t * t - t
+        })
+        .sum()
+}
+
 fn ranks(values: impl Iterator<Item = f64>) -> (Vec<f64>, Vec<usize>) {
     let v: Vec<f64> = values.collect();
     let mut order: Vec<usize> = (0..v.len()).collect();
@@ -198,13 +203,7 @@ pub fn signed_rank(x: &[f64], c: f64) -> SignedRank {
             method: PMethod::Exact,
         };
     }
-    let tie_term: f64 = ties
-        .iter()
-        .map(|&t| {
-            let t = t as f64;
-            t * t * t - t
-        })
-        .sum();
+    let tie_term = tie_correction(&ties);
     let var = nf * (nf + 1.0) * (2.0 * nf + 1.0) / 24.0 - tie_term / 48.0;
     let p = if var <= 0.0 {
         1.0

@@ -135,17 +135,6 @@ impl State<'_> {
         tr.log_start = self.log.len();
     }
 
-    /// Number of actions pushed since `tree_begin`.
-    #[inline]
-    pub fn tree_depth(&self) -> usize {
-        self.tree.path.len()
-    }
-
-    /// The actions pushed, root first.
-    pub fn tree_path(&self) -> &[u32] {
-        &self.tree.path
-    }
-
     /// True when candidate `c` may be applied at the current node: both triangles remain
     /// and the criterion allows it.
     #[inline]
