@@ -57,6 +57,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "quality": opt.quality,
             "time_s": opt.time_s,
             "nodes_expanded": null,
+            "trees": null,
         });
         if let Some(r) = report {
             v["check"] = serde_json::json!({

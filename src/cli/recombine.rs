@@ -83,6 +83,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "quality": out.quality,
             "time_s": out.time_s,
             "nodes_expanded": out.nodes_expanded,
+            "trees": out.trees,
             "decisions": out.decisions,
         });
         if let Some(p) = quality_pct {
@@ -107,7 +108,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             ),
             _ => println!("quality         {:.4} (sum of eta)", out.quality),
         }
-        println!("nodes expanded  {}", out.nodes_expanded);
+        println!(
+            "nodes expanded  {} ({} look-ahead trees)",
+            out.nodes_expanded, out.trees
+        );
         println!("time            {:.4} s", out.time_s);
         if let Some(p) = &args.output {
             println!("wrote           {}", p.display());

@@ -64,13 +64,12 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
         100.0 * 2.0 * out.quads as f64 / mesh.triangles as f64
     };
     // A tree of horizon h expands the nodes at depths 0..h-1: 1 + b + ... + b^(h-1) per
-    // decision. Solve for b (the nodes below the root: b + ... + b^(h-1) = N - 1). A tree of
+    // tree. Solve for b (the nodes below the root: b + ... + b^(h-1) = N - 1). A tree of
     // horizon 1 expands only its root, whatever its width: no branching factor.
     let branching_factor = match job.horizon {
-        Some(h) if h >= 2 && out.decisions > 0 => effective_branching_factor(
-            out.nodes_expanded as f64 / out.decisions as f64 - 1.0,
-            h - 1,
-        ),
+        Some(h) if h >= 2 && out.trees > 0 => {
+            effective_branching_factor(out.nodes_expanded as f64 / out.trees as f64 - 1.0, h - 1)
+        }
         _ => None,
     };
     RunRecord {
@@ -90,6 +89,7 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
             .map(|o| 100.0 * out.quality / o),
         time_s: out.time_s,
         nodes_expanded: out.nodes_expanded,
+        trees: out.trees,
         decisions: out.decisions,
         branching_factor,
         backend: manifest.backend.clone(),
@@ -384,13 +384,14 @@ pub(crate) mod tests {
             triangles_left: 2,
             quality: 15.0,
             nodes_expanded: 60,
+            trees: 10,
             decisions: 10,
             time_s: 0.5,
         };
         let r = make_record(&m, &job, out);
         assert_eq!(r.quality_pct, Some(75.0));
         assert_eq!(r.recombined_pct, 80.0);
-        // 6 nodes expanded per decision at h = 2: 1 + b = 6 -> b = 5.
+        // 6 nodes expanded per tree at h = 2: 1 + b = 6 -> b = 5.
         assert!((r.branching_factor.unwrap() - 5.0).abs() < 1e-9);
         assert_eq!(r.seed, job.seed);
     }

@@ -19,6 +19,8 @@ pub struct Outcome {
     pub quality: f64,
     /// Tree nodes expanded.
     pub nodes_expanded: u64,
+    /// Look-ahead trees built.
+    pub trees: u64,
     /// Decisions taken.
     pub decisions: u64,
     /// Seconds of search.
@@ -140,6 +142,7 @@ pub(crate) mod tests {
             triangles_left: (job.seed % 3) as usize,
             quality: (job.seed % 1000) as f64 / 100.0,
             nodes_expanded: u64::from(h) * 10 + job.seed % 7,
+            trees: 5,
             decisions: 5,
             time_s: 0.001 * f64::from(h),
         }

@@ -40,13 +40,18 @@ pub struct RunRecord {
     pub time_s: f64,
     /// Tree nodes expanded by the search (0 for "optimum").
     pub nodes_expanded: u64,
+    /// Look-ahead trees the search built: one per decision, except the selective decisions
+    /// whose root triangle had a single allowed action (no tree can change those); 0 for
+    /// "optimum" and in records written before this field existed.
+    #[serde(default)]
+    pub trees: u64,
     /// Actions applied (decisions taken) by the search; quads for "optimum".
     pub decisions: u64,
     /// Effective branching factor of the look-ahead tree, for `uniform` and `selective` with
-    /// h >= 2: the b with 1 + b + ... + b^(h-1) = nodes_expanded / decisions (a tree of horizon
+    /// h >= 2: the b with 1 + b + ... + b^(h-1) = nodes_expanded / trees (a tree of horizon
     /// h expands the nodes of depths 0..h-1; see
     /// [`crate::stats::describe::effective_branching_factor`]). `None` for h = 1 (only the root
-    /// is expanded, whatever its width), for the other algorithms, and without decisions.
+    /// is expanded, whatever its width), for the other algorithms, and without trees.
     pub branching_factor: Option<f64>,
     /// Name of the evaluator that computed eta ("cpu-twin", "vulkan: llvmpipe ...", ...).
     pub backend: String,

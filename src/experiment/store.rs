@@ -141,6 +141,7 @@ pub(crate) mod tests {
             quality_pct: Some(97.25),
             time_s: 0.01,
             nodes_expanded: 300,
+            trees: 48,
             decisions: 48,
             branching_factor: Some(1.9),
             backend: "cpu-twin".into(),

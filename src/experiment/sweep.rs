@@ -306,6 +306,7 @@ impl Worker for SearchWorker<'_> {
                 triangles_left: o.triangles_left,
                 quality: o.quality,
                 nodes_expanded: 0,
+                trees: 0,
                 decisions: o.quads as u64,
                 time_s: o.time_s,
             });
@@ -321,6 +322,7 @@ impl Worker for SearchWorker<'_> {
             triangles_left: out.triangles_left,
             quality: out.quality,
             nodes_expanded: out.nodes_expanded,
+            trees: out.trees,
             decisions: out.decisions,
             time_s: out.time_s,
         })

@@ -3,7 +3,7 @@
 //! [`write()`] reads a results directory (`runs.jsonl`, `manifest.json`) and writes `report.md`,
 //! `report.html` (figures inlined) and the figures as SVG files under `figures/`. The report
 //! holds, per mesh: a Table-1-style table (median quality % of optimum, recombined %, time,
-//! nodes per step per algorithm and horizon), the paper's own numbers beside ours, Fig.-8-style
+//! nodes per tree per algorithm and horizon), the paper's own numbers beside ours, Fig.-8-style
 //! box plots against horizon with the fitted branching factor, pictures of typical runs, and
 //! Mann–Whitney/Holm/Vargha–Delaney/bootstrap comparisons of consecutive horizons and against
 //! greedy; with [`ReportOptions::compare`], also one directory against another.
@@ -279,7 +279,7 @@ fn mesh_section(
                 format!("{:.2}", median(&Metric::Recombined.values(runs))),
                 fmt_sig(median(&Metric::Time.values(runs)), 3),
                 fmt_sig(
-                    median(&runs.iter().map(results::nodes_per_step).collect::<Vec<_>>()),
+                    median(&runs.iter().map(results::nodes_per_tree).collect::<Vec<_>>()),
                     3,
                 ),
                 fmt_opt(median_opt(runs, |r| r.branching_factor), 3),
@@ -294,7 +294,7 @@ fn mesh_section(
             "quality (% of optimum)",
             "recombined (%)",
             "time (s)",
-            "nodes per step",
+            "nodes per tree",
             "branching factor",
         ]
         .map(String::from)
@@ -304,9 +304,10 @@ fn mesh_section(
     doc.para(
         "Medians over the runs of each configuration. Quality is the sum of eta over the quads as \
          a percentage of the optimum; recombined is the percentage of triangles merged into \
-         quads; time is the search's wall time; nodes per step is tree nodes expanded per \
-         decision; the branching factor is the runner's effective branching factor, the b with \
-         1 + b + ... + b^(h-1) = nodes per step (none at h = 1).",
+         quads; time is the search's wall time; nodes per tree is tree nodes expanded per \
+         look-ahead tree (a selective decision whose root triangle has a single allowed action \
+         builds none); the branching factor is the runner's effective branching factor, the b \
+         with 1 + b + ... + b^(h-1) = nodes per tree (none at h = 1).",
     );
 
     paper_beside(doc, mesh, &configs);

@@ -7,12 +7,12 @@ use crate::experiment::{manifest, store};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// Tree nodes expanded per decision of a run (0 when no decision was made).
-pub fn nodes_per_step(run: &Run) -> f64 {
-    if run.decisions == 0 {
+/// Tree nodes expanded per look-ahead tree of a run (0 when it built none).
+pub fn nodes_per_tree(run: &Run) -> f64 {
+    if run.trees == 0 {
         0.0
     } else {
-        run.nodes_expanded as f64 / run.decisions as f64
+        run.nodes_expanded as f64 / run.trees as f64
     }
 }
 

@@ -129,6 +129,10 @@ pub struct RunOutcome {
     /// Tree nodes expanded (nodes whose children were generated); one per decision for the
     /// greedy policies.
     pub nodes_expanded: u64,
+    /// Look-ahead trees built: one per decision, except the selective decisions whose drawn
+    /// root triangle had a single allowed action (applied without a tree: none could change
+    /// it). The greedy policies count each decision as a tree of horizon 1.
+    pub trees: u64,
     /// Actions applied (= quads).
     pub decisions: u64,
     /// Time of the search itself, in seconds.
@@ -150,7 +154,8 @@ pub struct Searcher<'a> {
     cursor: usize,
     rng: ChaCha8Rng,
     nodes: u64,
-    near: Vec<u32>,
+    trees: u64,
+    near: Vec<state::Near>,
     used: Vec<bool>,
     /// Uniform tree: ranks of the actions allowed at the root; per depth, the ranks the
     /// path may have allowed.
@@ -184,6 +189,7 @@ impl<'a> Searcher<'a> {
             cursor: 0,
             rng: ChaCha8Rng::seed_from_u64(0),
             nodes: 0,
+            trees: 0,
             near: Vec::new(),
             allowed_ranks: Vec::new(),
             allowed_scan: 0,
@@ -203,6 +209,7 @@ impl<'a> Searcher<'a> {
         self.state.reset();
         self.cursor = 0;
         self.nodes = 0;
+        self.trees = 0;
         self.rng = ChaCha8Rng::seed_from_u64(seed);
         let start = Instant::now();
         let chosen = match algo {
@@ -224,6 +231,10 @@ impl<'a> Searcher<'a> {
         let table = self.state.table();
         let quality = chosen.iter().map(|&c| table.eta[c as usize]).sum();
         let quads = chosen.len();
+        let trees = match algo {
+            Algo::Selective { .. } => self.trees,
+            _ => quads as u64,
+        };
         let out = RunOutcome {
             quads,
             triangles_left: self.state.mesh().num_triangles() - 2 * quads,
@@ -233,6 +244,7 @@ impl<'a> Searcher<'a> {
             } else {
                 self.nodes
             },
+            trees,
             decisions: quads as u64,
             time_s,
             chosen,

@@ -226,7 +226,17 @@ impl Searcher<'_> {
             let n = self.state.bucket_len(k);
             let i = self.pick(n);
             let t = self.state.bucket_nth(k, i);
+            if k == 1 {
+                // One allowed action: no tree can change the decision, so none is built.
+                let c = table.by_triangle[t as usize]
+                    .into_iter()
+                    .find(|&c| c != NONE && self.state.is_allowed(c))
+                    .expect("a triangle of P_1 has an allowed action");
+                self.state.apply(c);
+                continue;
+            }
             self.nodes += 1;
+            self.trees += 1;
             self.state.tree_begin();
             let mut best = f64::NEG_INFINITY;
             let mut first = NONE;
@@ -260,13 +270,13 @@ impl Searcher<'_> {
     /// Best summed reward below the current node at depth `d < h`.
     fn selective_node(&mut self, d: u32, h: u32) -> f64 {
         let table = self.state.table();
-        let Some(t) = self.choose_triangle() else {
+        let Some((t, allowed)) = self.choose_triangle() else {
             return 0.0;
         };
         self.nodes += 1;
         let mut best = f64::NEG_INFINITY;
-        for c in table.by_triangle[t as usize] {
-            if c == NONE || !self.state.tree_allowed(c) {
+        for (i, c) in table.by_triangle[t as usize].into_iter().enumerate() {
+            if allowed & (1 << i) == 0 {
                 continue;
             }
             let v = table.eta[c as usize] + self.selective_child(c, d + 1, h);
@@ -277,29 +287,31 @@ impl Searcher<'_> {
         best
     }
 
-    /// The triangle to branch on below the root: uniformly from the first non-empty
-    /// `P_k ∩ N` (N: recombinable triangles across an edge of a quad of the path, in path
-    /// then side order), else from `P_min` (in increasing id).
-    fn choose_triangle(&mut self) -> Option<u32> {
+    /// The triangle to branch on below the root, with its allowed actions (bit i:
+    /// `by_triangle[t][i]`): uniformly from the first non-empty `P_k ∩ N` (N: recombinable
+    /// triangles across an edge of a quad of the path, in path then side order), else from
+    /// `P_min` (in increasing id).
+    fn choose_triangle(&mut self) -> Option<(u32, u8)> {
         self.near.clear();
         let mut kmin = u8::MAX;
-        for &(n, k, _) in self.state.tree_near() {
-            if k == 0 || k > kmin {
+        for slot in self.state.tree_near() {
+            if slot.k == 0 || slot.k > kmin {
                 continue;
             }
-            if k < kmin {
-                kmin = k;
+            if slot.k < kmin {
+                kmin = slot.k;
                 self.near.clear();
             }
-            if !self.near.contains(&n) {
-                self.near.push(n);
+            if !self.near.iter().any(|s| s.t == slot.t) {
+                self.near.push(*slot);
             }
         }
         if !self.near.is_empty() {
             let i = self.pick(self.near.len());
-            return Some(self.near[i]);
+            return Some((self.near[i].t, self.near[i].allowed));
         }
         let rng = &mut self.rng;
-        self.state.tree_pick_pmin(|n| pick_from(rng, n))
+        let t = self.state.tree_pick_pmin(|n| pick_from(rng, n))?;
+        Some((t, self.state.tree_allowed_mask(t)))
     }
 }

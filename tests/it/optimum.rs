@@ -318,6 +318,7 @@ fn cli_optimum_json() {
     assert_eq!(v["quads"], 80);
     assert_eq!(v["triangles_left"], 0);
     assert!(v["horizon"].is_null() && v["seed"].is_null() && v["nodes_expanded"].is_null());
+    assert!(v["trees"].is_null());
     let table = CandidateTable::build(&mesh);
     let opt = optimum::solve(&mesh, &table);
     let q = v["quality"].as_f64().expect("quality");

@@ -54,22 +54,17 @@ impl State<'_> {
     /// The quad vertices of candidate `c` that are clean (bits 0..4: closed fan, no used
     /// triangle), plus `LOCAL_PROOF` when the links at those vertices join every remaining
     /// neighbour of the quad (one part: the action is allowed). A handful of loads.
-    #[inline]
+    #[inline(always)]
     pub(super) fn clean_mask(&self, c: u32) -> u8 {
         let l = &self.cand_local[c as usize];
-        let mut mask = 0u8;
-        let mut live_bits = 0u8;
-        for i in 0..4 {
-            mask |= ((self.dead_count[l.quad[i] as usize] == 0) as u8) << i;
-            // `get` answers false for NONE (out of range): no separate test.
-            live_bits |= ((self.alive.get(l.nb[i] as usize) == Some(&true)) as u8) << i;
-        }
-        mask &= l.flags;
-        if LOCAL_OK[(live_bits | mask << 4) as usize] && !l.shared {
-            mask | LOCAL_PROOF
-        } else {
-            mask
-        }
+        let (dead, alive) = (&self.dead_count[..], &self.alive[..]);
+        let clean = |i: usize| ((dead[l.quad[i] as usize] == 0) as u8) << i;
+        // `get` answers false for NONE (out of range): no separate test.
+        let live = |i: usize| ((alive.get(l.nb[i] as usize) == Some(&true)) as u8) << i;
+        let mask = (clean(0) | clean(1) | clean(2) | clean(3)) & l.flags;
+        let live_bits = live(0) | live(1) | live(2) | live(3);
+        let proof = LOCAL_OK[(live_bits | mask << 4) as usize] & !l.shared;
+        mask | (proof as u8) << 4
     }
     /// [`State::check`] when the local proof does not settle it (or the quad has a
     /// neighbour across two of its sides); `mask`: the clean quad vertices.
@@ -185,49 +180,21 @@ impl State<'_> {
         for s in 0..ns {
             self.nseed[s] = self.queue[s].len();
         }
-        let nb = &self.mesh.topology.neighbours;
+        let nb = &self.mesh.topology.neighbours[..];
         loop {
             // The verdict can only change when a search runs dry or two groups meet.
             let mut event = false;
             for s in 0..ns {
-                // Disjoint field borrows: the hot loop reads no other state.
-                let queue = &mut self.queue[s];
-                let stamp = &mut self.stamp;
-                let group = &mut self.group;
-                let h = self.head[s];
-                if h == queue.len() {
-                    continue;
-                }
-                let x = queue[h];
-                self.head[s] = h + 1;
-                let own = base | s as u32;
-                for &u in &nb[x as usize] {
-                    if u == NONE {
-                        continue;
-                    }
-                    let ui = u as usize;
-                    let m = stamp[ui];
-                    if m < base {
-                        stamp[ui] = own;
-                        queue.push(u);
-                    } else if m != own && m != DEAD && m != base | BLOCKED {
-                        // Another search's triangle. Groups are kept flat (`group[s]` is
-                        // the root), so a meeting is one comparison; a merge relabels the
-                        // (at most 4) members.
-                        let (a, b) = (group[(m & 7) as usize], group[s]);
-                        if a != b {
-                            for g in group[..ns].iter_mut() {
-                                if *g == a {
-                                    *g = b;
-                                }
-                            }
-                            event = true;
-                        }
-                    }
-                }
-                if h + 1 == queue.len() {
-                    event = true;
-                }
+                event |= search_step(
+                    s,
+                    ns,
+                    base,
+                    nb,
+                    &mut self.queue[s],
+                    &mut self.head[s],
+                    &mut self.stamp,
+                    &mut self.group,
+                );
             }
             if !event {
                 continue;
@@ -451,4 +418,52 @@ impl State<'_> {
         self.log.push(Op::PolderSize { p, old: psize });
         self.polder_size[p as usize] = rest;
     }
+}
+
+/// One step of lockstep search `s` (of `ns`, marks `base | s`): visits the next triangle of
+/// its queue. True when that changed what the verdict can be: the search ran dry or met
+/// another group (the groups are then merged). Arguments apart so that the compiler knows
+/// they do not overlap.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn search_step(
+    s: usize,
+    ns: usize,
+    base: u32,
+    nb: &[[u32; 3]],
+    queue: &mut Vec<u32>,
+    head: &mut usize,
+    stamp: &mut [u32],
+    group: &mut [u8; 4],
+) -> bool {
+    let h = *head;
+    let Some(&x) = queue.get(h) else {
+        return false;
+    };
+    *head = h + 1;
+    let own = base | s as u32;
+    let mut event = false;
+    for &u in &nb[x as usize] {
+        // `get_mut` answers None for NONE (out of range): no separate test.
+        let Some(m) = stamp.get_mut(u as usize) else {
+            continue;
+        };
+        if *m < base {
+            *m = own;
+            queue.push(u);
+        } else if *m != own && *m != DEAD && *m != base | BLOCKED {
+            // Another search's triangle. Groups are kept flat (`group[s]` is the root), so a
+            // meeting is one comparison; a merge relabels the (at most 4) members.
+            let (a, b) = (group[(*m & 7) as usize], group[s]);
+            if a != b {
+                for g in group[..ns].iter_mut() {
+                    if *g == a {
+                        *g = b;
+                    }
+                }
+                event = true;
+            }
+        }
+    }
+    event || h + 1 == queue.len()
 }

@@ -45,6 +45,7 @@ mod tree;
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 use pk::OrderedSets;
+pub use tree::Near;
 use tree::Overlay;
 
 /// How a verdict was reached (what it depends on).

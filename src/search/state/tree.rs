@@ -26,6 +26,20 @@ use super::check::LOCAL_PROOF;
 use super::{DEAD, KIND_LOCAL, KIND_SPLIT, Op, State, Verdict};
 use crate::mesh::NONE;
 
+/// A triangle next to the path's quads, as [`State::tree_near`] lists it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Near {
+    /// The triangle.
+    pub t: u32,
+    /// Its number of allowed actions at the current node.
+    pub k: u8,
+    /// Bit i: its action `by_triangle[t][i]` is allowed at the current node.
+    pub allowed: u8,
+    /// Each of its actions was dead or allowed by the local proof: the entry holds while
+    /// the pushes use no triangle around a vertex of its quads.
+    local: bool,
+}
+
 /// A verdict computed inside the tree, with the depth and serial number of its node.
 #[derive(Debug, Clone, Copy, Default)]
 struct Cached {
@@ -43,9 +57,8 @@ pub(super) struct Overlay {
     /// `(depth of the overwriting node, candidate, the entry)`.
     shadowed: Vec<(u32, u32, Cached)>,
     /// `tree_near`'s lists, a stack with one list per depth (depth d: from `slots_end[d-1]`
-    /// to `slots_end[d]`; `slots_end[0] == 0`): triangle, its count, and whether each of
-    /// its actions was dead or allowed by the local proof.
-    slots: Vec<(u32, u8, bool)>,
+    /// to `slots_end[d]`; `slots_end[0] == 0`).
+    slots: Vec<Near>,
     slots_end: Vec<usize>,
     /// Serial number of the node each depth's list was computed at.
     slots_serial: Vec<u32>,
@@ -144,28 +157,33 @@ impl State<'_> {
 
     /// Number of allowed actions of triangle `t` at the current node (0 if used).
     pub fn tree_count(&mut self, t: u32) -> u32 {
-        if !self.alive[t as usize] {
-            return 0;
-        }
         if self.tree.is_empty() {
             return self.count[t as usize] as u32;
         }
-        let mut k = 0;
-        for c in self.table.by_triangle[t as usize] {
-            if c != NONE && self.tree_allowed(c) {
-                k += 1;
+        self.count_local(t).k as u32
+    }
+
+    /// Which actions of triangle `t` are allowed at the current node: bit i for
+    /// `by_triangle[t][i]` (0 if `t` is used).
+    pub fn tree_allowed_mask(&mut self, t: u32) -> u8 {
+        if self.tree.is_empty() {
+            let mut bits = 0;
+            for (i, c) in self.table.by_triangle[t as usize].into_iter().enumerate() {
+                if c != NONE && self.verdict[c as usize].allowed {
+                    bits |= 1 << i;
+                }
             }
+            return bits;
         }
-        k
+        self.count_local(t).allowed
     }
 
     /// The remaining triangles across the sides of the path's quads (root first, sides in
-    /// quad order; a triangle next to two quads appears twice) with their number of allowed
-    /// actions at the current node and whether each of their actions is dead or allowed by
-    /// the local proof. Incremental: the parent node's list minus the triangles the last
+    /// quad order; a triangle next to two quads appears twice) with their allowed actions at
+    /// the current node. Incremental: the parent node's list minus the triangles the last
     /// push used, each kept as it was when all its actions were dead or local there and the
     /// push used no triangle around any vertex of their quads, then the last quad's sides.
-    pub fn tree_near(&mut self) -> &[(u32, u8, bool)] {
+    pub fn tree_near(&mut self) -> &[Near] {
         let d = self.tree.path.len();
         if d == 0 {
             return &[];
@@ -191,20 +209,16 @@ impl State<'_> {
             tr.slots.truncate(hi);
             for i in lo..hi {
                 let tr = &self.tree;
-                let (t, k, local) = tr.slots[i];
+                let slot = tr.slots[i];
+                let t = slot.t;
                 if !self.alive[t as usize] {
                     continue;
                 }
-                let keep = local
+                let keep = slot.local
                     && tr.ring[t as usize]
                         .iter()
                         .all(|&v| v == NONE || tr.touched_at[v as usize] != here);
-                let slot = if keep {
-                    (t, k, local)
-                } else {
-                    let (k, local) = self.count_local(t);
-                    (t, k as u8, local)
-                };
+                let slot = if keep { slot } else { self.count_local(t) };
                 self.tree.slots.push(slot);
             }
             d - 1
@@ -218,8 +232,8 @@ impl State<'_> {
         for i in from..d {
             for t in self.cand_nb[self.tree.path[i] as usize] {
                 if t != NONE && self.alive[t as usize] {
-                    let (k, local) = self.count_local(t);
-                    self.tree.slots.push((t, k as u8, local));
+                    let slot = self.count_local(t);
+                    self.tree.slots.push(slot);
                 }
             }
         }
@@ -229,31 +243,41 @@ impl State<'_> {
         &tr.slots[start..]
     }
 
-    /// Allowed actions of `t` at the current node, and whether each of its actions is dead
-    /// or allowed by the local proof.
-    fn count_local(&mut self, t: u32) -> (u32, bool) {
+    /// The allowed actions of `t` at a node below the root, and whether each of its actions
+    /// is dead or allowed by the local proof.
+    fn count_local(&mut self, t: u32) -> Near {
+        let mut slot = Near {
+            t,
+            k: 0,
+            allowed: 0,
+            local: true,
+        };
         if !self.alive[t as usize] {
-            return (0, true);
+            return slot;
         }
-        let mut k = 0;
-        let mut local = true;
-        for c in self.table.by_triangle[t as usize] {
-            if c != NONE && self.is_live(c) {
-                let (allowed, kind) = self.tree_verdict(c);
-                k += allowed as u32;
-                local &= allowed && kind == KIND_LOCAL;
+        for (i, c) in self.table.by_triangle[t as usize].into_iter().enumerate() {
+            if c == NONE || !self.alive[self.table.other(c, t) as usize] {
+                continue;
             }
+            // The local proof inline; the rest of `tree_verdict` when it fails.
+            let mask = self.clean_mask(c);
+            let (allowed, local) = if mask & LOCAL_PROOF != 0 {
+                (true, true)
+            } else {
+                (self.tree_verdict_slow(c, mask).0, false)
+            };
+            slot.k += allowed as u8;
+            slot.allowed |= (allowed as u8) << i;
+            slot.local &= allowed && local;
         }
-        (k, local)
+        slot
     }
 
     /// `(allowed, kind)` of live candidate `c` at the current node.
+    #[inline]
     fn tree_verdict(&mut self, c: u32) -> (bool, u8) {
-        let ci = c as usize;
-        let tr = &self.tree;
-        let d = tr.path.len();
-        if d == 0 {
-            let v = &self.verdict[ci];
+        if self.tree.path.is_empty() {
+            let v = &self.verdict[c as usize];
             return (v.allowed, v.kind);
         }
         // The local proof costs a few loads: cheaper than looking anything up. When it
@@ -262,6 +286,16 @@ impl State<'_> {
         if mask & LOCAL_PROOF != 0 {
             return (true, KIND_LOCAL);
         }
+        self.tree_verdict_slow(c, mask)
+    }
+
+    /// [`State::tree_verdict`] below the root when the local proof fails (`mask`: the clean
+    /// quad vertices): the cached or base verdict if it still holds, else a new one.
+    #[inline(never)]
+    fn tree_verdict_slow(&mut self, c: u32, mask: u8) -> (bool, u8) {
+        let ci = c as usize;
+        let tr = &self.tree;
+        let d = tr.path.len();
         let e = tr.cached[ci];
         let od = e.depth as usize;
         let ancestor = od <= d && tr.serial[od] == e.serial;
@@ -277,7 +311,7 @@ impl State<'_> {
                 return (a, v.kind);
             }
         }
-        let mut v = self.check_slow(c, mask);
+        let mut v = self.check_slow(c, mask & 0xF);
         (v.cert, v.cert_len) = self.append_cert(v.kind, true);
         let tr = &mut self.tree;
         if ancestor && od < d {
@@ -300,10 +334,11 @@ impl State<'_> {
         );
         let ci = c as usize;
         let [t0, t1] = self.table.pairs[ci];
-        let (_, kind) = self.tree_verdict(c);
+        // Only a split changes more than the polder's size.
+        let split = self.clean_mask(c) & LOCAL_PROOF == 0 && self.tree_verdict(c).1 == KIND_SPLIT;
         self.log.push(Op::TreeApply(c));
         self.tree.changed_len.push(self.tree.changed.len());
-        if kind == KIND_SPLIT {
+        if split {
             // The parts are needed to relabel them: search again (the smaller parts).
             let again = self.check(c);
             debug_assert_eq!(again.kind, KIND_SPLIT);

@@ -129,6 +129,16 @@ impl Replay<'_> {
     fn run(mut self) -> Vec<u32> {
         let mut chosen = Vec::new();
         while let Some(t) = self.pmin() {
+            let allowed: Vec<u32> = self.table.by_triangle[t as usize]
+                .into_iter()
+                .filter(|&c| c != NONE && self.oracle.is_allowed(c))
+                .collect();
+            if let [only] = allowed[..] {
+                // A single allowed action is applied without a tree (no draws below it).
+                self.oracle.apply(only);
+                chosen.push(only);
+                continue;
+            }
             let mut best = f64::NEG_INFINITY;
             let mut first = NONE;
             for c in self.table.by_triangle[t as usize] {

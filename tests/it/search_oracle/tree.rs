@@ -25,6 +25,17 @@ fn naive_count(oracle: &Naive, table: &CandidateTable, t: u32) -> u32 {
         .count() as u32
 }
 
+/// Bit i: action `by_triangle[t][i]` allowed, by the oracle.
+fn naive_mask(oracle: &Naive, table: &CandidateTable, t: u32) -> u8 {
+    let mut bits = 0;
+    for (i, &c) in table.by_triangle[t as usize].iter().enumerate() {
+        if c != NONE && oracle.is_remaining(t) && oracle.is_allowed(c) {
+            bits |= 1 << i;
+        }
+    }
+    bits
+}
+
 /// `P_min` by the oracle, in increasing id; `None` when no action is allowed.
 fn naive_pmin(oracle: &Naive, table: &CandidateTable, nt: u32) -> Option<Vec<u32>> {
     let counts: Vec<u32> = (0..nt).map(|t| naive_count(oracle, table, t)).collect();
@@ -81,6 +92,14 @@ fn check_node(
                 context()
             ));
         }
+        let (got, expected) = (state.tree_allowed_mask(t), naive_mask(oracle, table, t));
+        queries += 1;
+        if got != expected {
+            return Err(format!(
+                "{}\n  tree_allowed_mask({t}): expected {expected:#b}, got {got:#b}",
+                context()
+            ));
+        }
     }
     let slots = state.tree_near().to_vec();
     let expected: Vec<(u32, u8)> = tree_path
@@ -89,7 +108,19 @@ fn check_node(
         .filter(|&n| n != NONE && oracle.is_remaining(n))
         .map(|n| (n, naive_count(oracle, table, n) as u8))
         .collect();
-    let got: Vec<(u32, u8)> = slots.iter().map(|&(t, k, _)| (t, k)).collect();
+    let got: Vec<(u32, u8)> = slots.iter().map(|s| (s.t, s.k)).collect();
+    for s in &slots {
+        let expected = naive_mask(oracle, table, s.t);
+        queries += 1;
+        if s.allowed != expected {
+            return Err(format!(
+                "{}\n  tree_near(): triangle {} allowed actions {:#b}, expected {expected:#b}",
+                context(),
+                s.t,
+                s.allowed
+            ));
+        }
+    }
     queries += 1;
     if got != expected {
         return Err(format!(
