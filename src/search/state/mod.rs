@@ -26,8 +26,9 @@
 //!   verdicts in the parts that changed. Proof sketch in `docs/search.md`.
 //! * Polder ids and sizes are kept per triangle; a split relabels only the finished
 //!   (smaller) parts the search already enumerated.
-//! * `P_k` are kept as counting Fenwick trees over triangle ids (`pk`): a uniform draw takes
-//!   the i-th member in increasing id order, so it depends on the current state only.
+//! * `P_k` are kept as bitmaps over triangle ids with a counting Fenwick tree over blocks
+//!   (`pk`): a uniform draw takes the i-th member in increasing id order, so it depends on
+//!   the current state only.
 //! * **Look-ahead trees** (`tree`) explore on top of this exact base state without
 //!   maintaining it: `tree_push` / `tree_pop` change only what the criterion reads (remaining
 //!   triangles, fans, dead components, polders), and a verdict asked for inside the tree is
