@@ -153,6 +153,7 @@ impl Searcher<'_> {
         let table = self.state.table();
         let rest = (h - d - 1) as f64 * top;
         let mut any = false;
+        let mut cut = false;
         let mut expanded = false;
         // Ranks to look at, in order: the actions allowed at the root and, below it, the
         // actions forbidden at the root that the path may have allowed (every other action
@@ -166,7 +167,15 @@ impl Searcher<'_> {
         if d > 0 {
             self.state.tree_affected(&mut extra);
             let (state, rank, cursor) = (&self.state, &self.rank, self.cursor);
-            extra.retain(|&c| !state.is_allowed(c) && rank[c as usize] as usize >= cursor);
+            // An action whose reward cannot beat `best` now never will (`best` only grows,
+            // and the loop below stops at the first such action in eta order): leave it out
+            // before sorting.
+            let floor = *best - partial - rest - BOUND_SLACK;
+            extra.retain(|&c| {
+                table.eta[c as usize] > floor
+                    && !state.is_allowed(c)
+                    && rank[c as usize] as usize >= cursor
+            });
             extra.iter_mut().for_each(|c| *c = rank[*c as usize]);
             extra.sort_unstable();
             extra.dedup();
@@ -186,14 +195,17 @@ impl Searcher<'_> {
                 b
             };
             let c = self.order[r as usize];
+            let eta = table.eta[c as usize];
+            // In eta order: once the bound fails it fails for every later action, allowed
+            // or not, so no verdict is needed to stop.
+            if partial + eta + rest + BOUND_SLACK <= *best {
+                cut = true;
+                break;
+            }
             if !self.state.tree_allowed(c) {
                 continue;
             }
             any = true;
-            let eta = table.eta[c as usize];
-            if partial + eta + rest + BOUND_SLACK <= *best {
-                break;
-            }
             if !expanded {
                 expanded = true;
                 self.nodes += 1;
@@ -212,7 +224,7 @@ impl Searcher<'_> {
             }
         }
         self.extra[du] = extra;
-        if !any && d > 0 && partial > *best {
+        if !any && !cut && d > 0 && partial > *best {
             // No action left: a shorter sequence is a leaf.
             *best = partial;
             *first = root;
