@@ -1,7 +1,7 @@
 //! `quadrecomb info`: a mesh's size, topology and candidate quad qualities, with parse time.
 
 use quadrecomb::mesh;
-use quadrecomb::quality::CandidateTable;
+use quadrecomb::quality::{self, CandidateTable};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -41,6 +41,9 @@ struct Info {
     ignored_elements: usize,
     /// eta statistics of the candidates; absent (null) when there are none.
     eta: Option<EtaStats>,
+    /// eta statistics of the input quads (a recombined mesh's quads: their mean times their
+    /// number is the run's quality); absent (null) when there are none.
+    quad_eta: Option<EtaStats>,
     time_ms: Times,
 }
 
@@ -98,6 +101,42 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         if file.binary { "binary" } else { "ascii" }
     );
     let ignored_elements = file.ignored_elements;
+    let quad_eta = eta_stats(&quad_etas(&file.data));
+    if file.data.triangles.is_empty() && !file.data.quads.is_empty() {
+        // Quads only (a fully recombined mesh, say): nothing to recombine, but its size and
+        // quad quality are worth reporting.
+        let mut data = file.data;
+        data.materialise_defaults();
+        let surfaces = {
+            let mut s = data.quad_surface.clone();
+            s.sort_unstable();
+            s.dedup();
+            s.len()
+        };
+        let info = Info {
+            mesh: args.mesh,
+            format,
+            vertices: data.vertices.len(),
+            triangles: 0,
+            quads: data.quads.len(),
+            surfaces,
+            components: 0,
+            odd_components: 0,
+            boundary_edges: 0,
+            candidate_pairs: 0,
+            reoriented_triangles: 0,
+            ignored_elements,
+            eta: None,
+            quad_eta,
+            time_ms: Times {
+                read,
+                parse,
+                topology: 0.0,
+                candidates: 0.0,
+            },
+        };
+        return print(&info, args.json);
+    }
     let t = Instant::now();
     let m = file.into_mesh(&src.path)?;
     let topology = ms(t);
@@ -120,6 +159,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         reoriented_triangles: m.reoriented,
         ignored_elements,
         eta: eta_stats(&table.eta),
+        quad_eta,
         time_ms: Times {
             read,
             parse,
@@ -127,10 +167,26 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             candidates,
         },
     };
-    let out = if args.json {
-        serde_json::to_string_pretty(&info)? + "\n"
+    print(&info, args.json)
+}
+
+/// eta of each quad of `data`, its vertices in order (the diagonal from the first to the
+/// third, as `recombine` writes them), or none when a vertex index is out of range.
+fn quad_etas(data: &mesh::MeshData) -> Vec<f64> {
+    let nv = data.vertices.len();
+    data.quads
+        .iter()
+        .filter(|q| q.iter().all(|&v| (v as usize) < nv))
+        .map(|q| quality::quad_eta(q.map(|v| data.vertices[v as usize])))
+        .collect()
+}
+
+/// Prints `info` as text or JSON.
+fn print(info: &Info, json: bool) -> anyhow::Result<ExitCode> {
+    let out = if json {
+        serde_json::to_string_pretty(info)? + "\n"
     } else {
-        text(&info)
+        text(info)
     };
     // A closed pipe (`| head`) is not an error worth a panic or a message.
     match std::io::stdout().write_all(out.as_bytes()) {
@@ -185,6 +241,16 @@ fn text(i: &Info) -> String {
             }
         }
         None => wln!(s, "candidate eta:        (no candidates)"),
+    }
+    if let Some(e) = &i.quad_eta {
+        wln!(
+            s,
+            "quad eta (input):     min {:.4}  mean {:.4}  max {:.4}  (sum {:.4})",
+            e.min,
+            e.mean,
+            e.max,
+            e.mean * i.quads as f64
+        );
     }
     let t = &i.time_ms;
     wln!(

@@ -861,3 +861,77 @@ fn bench_io_reports_each_mesh() {
     let missing = run_in(dir.path(), &["bench", "io", "no_such.msh"]);
     assert_eq!(missing.status.code(), Some(2));
 }
+
+/// A mesh of quads only (a fully recombined one, say) is not an error for `info`: it reports
+/// its size and its quads' eta (`recombine` still refuses it: nothing to recombine).
+#[test]
+fn info_reports_a_quad_only_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("quads.msh");
+    // Two unit squares side by side (eta 1) and a trapezoid above them, on another surface.
+    std::fs::write(
+        &p,
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 2 0 0\n\
+         4 0 1 0\n5 1 1 0\n6 2 1 0\n7 0 3 0\n8 3 3 0\n$EndNodes\n$Elements\n3\n\
+         1 3 2 0 1 1 2 5 4\n2 3 2 0 1 2 3 6 5\n3 3 2 0 2 4 6 8 7\n$EndElements\n",
+    )
+    .unwrap();
+    let out = run_in(dir.path(), &["info", "--json", p.to_str().unwrap()]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["triangles"], 0);
+    assert_eq!(v["quads"], 3);
+    assert_eq!(v["vertices"], 8);
+    assert_eq!(v["surfaces"], 2);
+    assert!(v["eta"].is_null());
+    let trapezoid = quality::quad_eta([[0., 1., 0.], [2., 1., 0.], [3., 3., 0.], [0., 3., 0.]]);
+    assert!(trapezoid < 0.9);
+    assert_eq!(v["quad_eta"]["max"].as_f64().unwrap(), 1.0);
+    assert_eq!(v["quad_eta"]["min"].as_f64().unwrap(), trapezoid);
+    let text = run_in(dir.path(), &["info", p.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&text.stdout).contains("quad eta (input):"));
+    let rec = run_in(
+        dir.path(),
+        &["recombine", p.to_str().unwrap(), "--algo", "greedy"],
+    );
+    assert_eq!(rec.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&rec.stderr).contains("no triangles"));
+}
+
+/// `info` on what `recombine -o` wrote: the quads' eta sums to the run's quality.
+#[test]
+fn info_quad_eta_sums_to_the_quality_of_a_written_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_in(
+        dir.path(),
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "selective",
+            "--horizon",
+            "2",
+            "--seed",
+            "5",
+            "--json",
+            "--no-optimum",
+            "-o",
+            "out.msh",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let run: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let info = run_in(dir.path(), &["info", "--json", "out.msh"]);
+    assert_eq!(info.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(v["quads"], run["quads"]);
+    assert_eq!(v["triangles"], run["triangles_left"]);
+    let sum = v["quad_eta"]["mean"].as_f64().unwrap() * v["quads"].as_f64().unwrap();
+    let quality = run["quality"].as_f64().unwrap();
+    assert!((sum - quality).abs() < 1e-9 * quality, "{sum} vs {quality}");
+}
