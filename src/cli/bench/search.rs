@@ -32,6 +32,9 @@ fn thread_cpu_s() -> Option<f64> {
     Some(ns * 1e-9)
 }
 
+/// Rounds of the grid rows.
+const GRID_ROUNDS: usize = 3;
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -156,16 +159,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     drop(s);
 
-    println!("\nSelective h=3 on generated jittered grids (one surface, no hole):\n");
-    println!("| triangles | runs | wall ms | cpu ms | ns per triangle (wall) | recombined % |");
-    println!("|---:|---:|---:|---:|---:|---:|");
+    println!(
+        "\nSelective h=3 on generated jittered grids (one surface, no hole), {GRID_ROUNDS} rounds \
+         alternating the sizes (this VM's speed drifts from minute to minute): ns per triangle \
+         of the search, median over the seeds of a round, best and worst round:\n"
+    );
+    println!(
+        "| triangles | runs per round | ns per triangle (best round) | worst round | recombined % |"
+    );
+    println!("|---:|---:|---:|---:|---:|");
+    // As `generate grid` then `mesh::load` would give them: in spatial order.
+    let mut grids = Vec::new();
     let mut n = 10_000;
     while n <= args.max_grid {
         let g = generate::grid(GridSpec {
             triangles: n,
             ..GridSpec::default()
         });
-        // As `generate grid` then `mesh::load` would give it: in spatial order.
         let mut data = mesh::MeshData {
             vertices: g.vertices.clone(),
             triangles: g.triangles.clone(),
@@ -173,35 +183,47 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         };
         mesh::order::spatial(&mut data);
         let g = mesh::Mesh::new(data)?;
-        let gt = CandidateTable::build(&g);
-        let mut s = Searcher::new(&g, &gt);
-        // Small grids take milliseconds: more seeds there, so that every row's median rests
-        // on about as much work (the thread-CPU clock of some VMs ticks in 4 ms steps, so
-        // the per-triangle figure uses the search's own wall clock).
-        let runs = if n >= 1_000_000 {
+        let t = CandidateTable::build(&g);
+        grids.push((g, t));
+        n *= 10;
+    }
+    let mut searchers: Vec<Searcher<'_>> = grids.iter().map(|(g, t)| Searcher::new(g, t)).collect();
+    // Small grids take milliseconds: more seeds there, so that every row's median rests on
+    // about as much work (the thread-CPU clock of some VMs ticks in 4 ms steps, so the figure
+    // uses the search's own wall clock).
+    let runs_for = |nt: usize| {
+        if nt >= 1_000_000 {
             args.runs.min(3)
         } else {
-            args.runs * (100_000 / n as u64).max(1)
-        };
-        let r = measure(
-            &mut s,
-            "grid",
-            g.num_triangles(),
-            None,
-            Algo::Selective { horizon: 3 },
-            runs,
-        );
-        let per = r.wall_ms * 1e6 / g.num_triangles() as f64;
+            args.runs * (100_000 / nt as u64).max(1)
+        }
+    };
+    let mut per = vec![Vec::new(); grids.len()];
+    let mut recombined = vec![0.0; grids.len()];
+    for _ in 0..GRID_ROUNDS {
+        for (i, ((g, _), s)) in grids.iter().zip(&mut searchers).enumerate() {
+            let nt = g.num_triangles();
+            let r = measure(
+                s,
+                "grid",
+                nt,
+                None,
+                Algo::Selective { horizon: 3 },
+                runs_for(nt),
+            );
+            per[i].push(r.wall_ms * 1e6 / nt as f64);
+            recombined[i] = r.recombined_pct;
+        }
+    }
+    for (i, (g, _)) in grids.iter().enumerate() {
+        let nt = g.num_triangles();
+        let best = per[i].iter().copied().fold(f64::INFINITY, f64::min);
+        let worst = per[i].iter().copied().fold(0.0, f64::max);
         println!(
-            "| {} | {} | {:.1} | {} | {:.0} | {:.2} |",
-            g.num_triangles(),
-            runs,
-            r.wall_ms,
-            r.cpu_ms.map_or("-".into(), |c| format!("{c:.1}")),
-            per,
-            r.recombined_pct
+            "| {nt} | {} | {best:.0} | {worst:.0} | {:.2} |",
+            runs_for(nt),
+            recombined[i]
         );
-        n *= 10;
     }
     Ok(ExitCode::SUCCESS)
 }
