@@ -101,25 +101,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         if file.binary { "binary" } else { "ascii" }
     );
     let ignored_elements = file.ignored_elements;
-    let quad_eta = eta_stats(&quad_etas(&file.data));
     if file.data.triangles.is_empty() && !file.data.quads.is_empty() {
         // Quads only (a fully recombined mesh, say): nothing to recombine, but its size and
-        // quad quality are worth reporting.
+        // quad quality are worth reporting, once its elements are checked as any mesh's.
         let mut data = file.data;
-        data.materialise_defaults();
-        let surfaces = {
-            let mut s = data.quad_surface.clone();
-            s.sort_unstable();
-            s.dedup();
-            s.len()
-        };
+        data.check_elements()
+            .map_err(|source| mesh::ReadError::Mesh {
+                path: src.path.clone(),
+                source,
+            })?;
         let info = Info {
             mesh: args.mesh,
             format,
             vertices: data.vertices.len(),
             triangles: 0,
             quads: data.quads.len(),
-            surfaces,
+            surfaces: data.surfaces().len(),
             components: 0,
             odd_components: 0,
             boundary_edges: 0,
@@ -127,7 +124,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             reoriented_triangles: 0,
             ignored_elements,
             eta: None,
-            quad_eta,
+            quad_eta: eta_stats(&quad_etas(&data.vertices, &data.quads)),
             time_ms: Times {
                 read,
                 parse,
@@ -159,7 +156,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         reoriented_triangles: m.reoriented,
         ignored_elements,
         eta: eta_stats(&table.eta),
-        quad_eta,
+        quad_eta: eta_stats(&quad_etas(&m.vertices, &m.quads)),
         time_ms: Times {
             read,
             parse,
@@ -170,14 +167,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     print(&info, args.json)
 }
 
-/// eta of each quad of `data`, its vertices in order (the diagonal from the first to the
-/// third, as `recombine` writes them), or none when a vertex index is out of range.
-fn quad_etas(data: &mesh::MeshData) -> Vec<f64> {
-    let nv = data.vertices.len();
-    data.quads
+/// eta of each quad (checked vertex indices), its vertices in order: the diagonal from the
+/// first to the third, as `recombine` writes them.
+fn quad_etas(vertices: &[[f64; 3]], quads: &[[u32; 4]]) -> Vec<f64> {
+    quads
         .iter()
-        .filter(|q| q.iter().all(|&v| (v as usize) < nv))
-        .map(|q| quality::quad_eta(q.map(|v| data.vertices[v as usize])))
+        .map(|q| quality::quad_eta(q.map(|v| vertices[v as usize])))
         .collect()
 }
 

@@ -63,6 +63,62 @@ pub struct MeshData {
 }
 
 impl MeshData {
+    /// Fills the defaults ([`MeshData::materialise_defaults`]) and checks what every element
+    /// must satisfy, triangle or quad: finite coordinates, nodes that exist, no node twice in
+    /// one element. [`Mesh::new`] does this first; a mesh of quads only (which it refuses:
+    /// nothing to recombine) can still be checked and described.
+    pub fn check_elements(&mut self) -> Result<(), MeshError> {
+        self.materialise_defaults();
+        let nv = self.vertices.len();
+        assert_eq!(self.vertex_ids.len(), nv, "one id per vertex");
+        assert_eq!(
+            self.triangle_ids.len(),
+            self.triangles.len(),
+            "one id per triangle"
+        );
+        for (i, p) in self.vertices.iter().enumerate() {
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(MeshError::NonFiniteCoordinate {
+                    node: self.vertex_ids[i],
+                    x: p[0],
+                    y: p[1],
+                    z: p[2],
+                });
+            }
+        }
+        let elements = self
+            .triangles
+            .iter()
+            .map(|t| &t[..])
+            .zip(&self.triangle_ids)
+            .chain(self.quads.iter().map(|q| &q[..]).zip(&self.quad_ids));
+        for (nodes, &element) in elements {
+            for (k, &v) in nodes.iter().enumerate() {
+                if v as usize >= nv {
+                    // Readers map unknown tags to indices past the end; report the index as
+                    // given.
+                    return Err(MeshError::UnknownNode {
+                        element,
+                        node: v as u64 + 1,
+                    });
+                }
+                if nodes[..k].contains(&v) {
+                    return Err(MeshError::RepeatedNode {
+                        element,
+                        node: self.vertex_ids[v as usize],
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Distinct surface tags of the triangles and quads, sorted (after
+    /// [`MeshData::materialise_defaults`]).
+    pub fn surfaces(&self) -> Vec<i32> {
+        distinct_surfaces(&self.triangle_surface, &self.quad_surface)
+    }
+
     /// Fills the tags and surfaces left empty with what empty means: nodes and triangles
     /// numbered from 1, quads numbered after the triangles, everything on surface 1.
     pub fn materialise_defaults(&mut self) {
@@ -106,15 +162,7 @@ impl Mesh {
 
     /// Distinct surface tags, sorted.
     pub fn surfaces(&self) -> Vec<i32> {
-        let mut s: Vec<i32> = self
-            .triangle_surface
-            .iter()
-            .chain(&self.quad_surface)
-            .copied()
-            .collect();
-        s.sort_unstable();
-        s.dedup();
-        s
+        distinct_surfaces(&self.triangle_surface, &self.quad_surface)
     }
 
     /// Checks every invariant of the mesh and its topology; returns the first violation.
@@ -147,4 +195,12 @@ impl Recombined {
             ..Recombined::default()
         }
     }
+}
+
+/// Distinct tags of `a` and `b`, sorted.
+fn distinct_surfaces(a: &[i32], b: &[i32]) -> Vec<i32> {
+    let mut s: Vec<i32> = a.iter().chain(b).copied().collect();
+    s.sort_unstable();
+    s.dedup();
+    s
 }

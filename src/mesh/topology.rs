@@ -53,44 +53,8 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             triangles: nt,
         });
     }
-    data.materialise_defaults();
-    assert_eq!(data.vertex_ids.len(), nv, "one id per vertex");
-    assert_eq!(data.triangle_ids.len(), nt, "one id per triangle");
+    data.check_elements()?;
     assert_eq!(data.triangle_surface.len(), nt, "one surface per triangle");
-
-    for (i, p) in data.vertices.iter().enumerate() {
-        if !p.iter().all(|c| c.is_finite()) {
-            return Err(MeshError::NonFiniteCoordinate {
-                node: data.vertex_ids[i],
-                x: p[0],
-                y: p[1],
-                z: p[2],
-            });
-        }
-    }
-    let elements = data
-        .triangles
-        .iter()
-        .map(|t| &t[..])
-        .zip(&data.triangle_ids)
-        .chain(data.quads.iter().map(|q| &q[..]).zip(&data.quad_ids));
-    for (nodes, &element) in elements {
-        for (k, &v) in nodes.iter().enumerate() {
-            if v as usize >= nv {
-                // Readers map unknown tags to indices past the end; report the index as given.
-                return Err(MeshError::UnknownNode {
-                    element,
-                    node: v as u64 + 1,
-                });
-            }
-            if nodes[..k].contains(&v) {
-                return Err(MeshError::RepeatedNode {
-                    element,
-                    node: data.vertex_ids[v as usize],
-                });
-            }
-        }
-    }
     for (t, tri) in data.triangles.iter().enumerate() {
         let [a, b, c] = tri.map(|v| data.vertices[v as usize]);
         let (u, w) = (sub(b, a), sub(c, a));

@@ -433,15 +433,16 @@ fn recombine_cli_prints_json_and_writes_meshes() {
     let lib = search::run(&mesh, &table, Algo::Selective { horizon: 2 }, 7);
     assert_eq!(lib.quads as u64, quads);
     assert!((lib.quality - v["quality"].as_f64().unwrap()).abs() < 1e-9);
-    // The written mesh holds the quads and the leftover triangles.
-    // (Parsed, not validated: a run may recombine every triangle, and a mesh without
-    // triangles is not one `recombine` accepts.)
-    let out = dir.path().join("out.msh");
-    let back = quadrecomb::mesh::msh::parse(&out, &std::fs::read(&out).unwrap())
-        .unwrap()
-        .data;
-    assert_eq!(back.quads.len() as u64, quads);
-    assert_eq!(back.triangles.len() as u64, left);
+    // The written mesh holds the quads and the leftover triangles, and `info` on it (quads
+    // only when the run recombined every triangle) sums the quads' eta to the run's quality.
+    let info = crate::util::run_in(dir.path(), &["info", "--json", "out.msh"]);
+    assert_eq!(info.status.code(), Some(0));
+    let back: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(back["quads"].as_u64(), Some(quads));
+    assert_eq!(back["triangles"].as_u64(), Some(left));
+    let sum = back["quad_eta"]["mean"].as_f64().unwrap() * quads as f64;
+    let quality = v["quality"].as_f64().unwrap();
+    assert!((sum - quality).abs() < 1e-9 * quality, "{sum} vs {quality}");
     let vtu = crate::util::run_in(
         dir.path(),
         &[

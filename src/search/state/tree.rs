@@ -335,12 +335,7 @@ impl State<'_> {
         let ci = c as usize;
         let [t0, t1] = self.table.pairs[ci];
         // Only a split changes more than the polder's size.
-        let split = if self.tree.path.is_empty() {
-            self.verdict[ci].kind == KIND_SPLIT
-        } else {
-            let mask = self.clean_mask(c);
-            mask & LOCAL_PROOF == 0 && self.tree_verdict_slow(c, mask).1 == KIND_SPLIT
-        };
+        let split = self.tree_verdict(c).1 == KIND_SPLIT;
         self.log.push(Op::TreeApply(c));
         self.tree.changed_len.push(self.tree.changed.len());
         if split {
