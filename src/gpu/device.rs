@@ -5,9 +5,9 @@ use super::layout::{Batch, LOCAL_QUAD_BYTES, Params, VERTEX_BYTES, Vertex};
 use super::{GpuError, shader};
 use std::borrow::Cow;
 use std::sync::{Mutex, mpsc};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
-/// Invocations per workgroup (`@workgroup_size` in the shader).
+/// Invocations per workgroup of the stream-copy kernel (`@workgroup_size` in its shader).
 const WORKGROUP: usize = 256;
 
 /// Every Vulkan adapter the loader reports, best first: discrete, integrated, virtual,
@@ -91,6 +91,43 @@ pub enum Layout {
     Local,
 }
 
+/// How the quality kernel is built: the candidate layout and the workgroup size (the WGSL
+/// override `WG`). The defaults are the production kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KernelOptions {
+    /// How candidates reach the kernel.
+    pub layout: Layout,
+    /// Invocations per workgroup (1 to the adapter's limit).
+    pub workgroup: u32,
+    /// The benchmark's diagnostic: the same memory accesses with almost no arithmetic (the
+    /// output is not eta).
+    pub memory_only: bool,
+}
+
+impl Default for KernelOptions {
+    fn default() -> Self {
+        KernelOptions {
+            layout: Layout::Indexed,
+            workgroup: 256,
+            memory_only: false,
+        }
+    }
+}
+
+impl std::fmt::Display for KernelOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let layout = match self.layout {
+            Layout::Indexed => "indexed",
+            Layout::Local => "local edges",
+        };
+        write!(f, "{layout}, wg {}", self.workgroup)?;
+        if self.memory_only {
+            f.write_str(", memory accesses only")?;
+        }
+        Ok(())
+    }
+}
+
 /// The quality pipeline on one device, built once and reused for every batch.
 #[derive(Debug)]
 pub struct Kernel {
@@ -99,7 +136,7 @@ pub struct Kernel {
     timestamps: bool,
     max_chunk: usize,
     max_vertices: usize,
-    kind: Layout,
+    options: KernelOptions,
     buffers: Mutex<Option<Buffers>>,
 }
 
@@ -115,27 +152,35 @@ struct Buffers {
     read: wgpu::Buffer,
     bind: wgpu::BindGroup,
     queries: Option<Timestamps>,
+    /// The grid of the last dispatch (what [`Kernel::dispatch_times`] repeats).
+    last_grid: Option<(u32, u32)>,
 }
 
-/// Two device timestamps around compute passes: the query set, and the buffers its values are
-/// resolved into and read back from.
+/// Device timestamps around compute passes (pairs: 0 and 1 around one pass, ...): the query
+/// set, and the buffers its values are resolved into and read back from.
 #[derive(Debug)]
 struct Timestamps {
     set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
     read: wgpu::Buffer,
+    count: u32,
 }
 
 impl Timestamps {
     /// `None` when the adapter cannot write timestamps.
     fn new(device: &wgpu::Device, label: &str) -> Option<Timestamps> {
+        Timestamps::with_count(device, label, 2)
+    }
+
+    /// Room for `count` timestamps.
+    fn with_count(device: &wgpu::Device, label: &str, count: u32) -> Option<Timestamps> {
         if !device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
             return None;
         }
         let buffer = |usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: 16,
+                size: 8 * count as u64,
                 usage,
                 mapped_at_creation: false,
             })
@@ -144,10 +189,11 @@ impl Timestamps {
             set: device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some(label),
                 ty: wgpu::QueryType::Timestamp,
-                count: 2,
+                count,
             }),
             resolve: buffer(wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC),
             read: buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST),
+            count,
         })
     }
 
@@ -160,16 +206,27 @@ impl Timestamps {
         }
     }
 
-    /// Records the copy of both timestamps to the readback buffer.
+    /// Records the copy of every timestamp to the readback buffer.
     fn resolve(&self, enc: &mut wgpu::CommandEncoder) {
-        enc.resolve_query_set(&self.set, 0..2, &self.resolve, 0);
-        enc.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, 16);
+        let bytes = 8 * self.count as u64;
+        enc.resolve_query_set(&self.set, 0..self.count, &self.resolve, 0);
+        enc.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, bytes);
     }
 
     /// Seconds between the two timestamps, once the work has been submitted.
     fn seconds(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<f64, GpuError> {
-        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&read_back(device, &self.read, 16)?);
-        Ok(ticks[1].wrapping_sub(ticks[0]) as f64 * queue.get_timestamp_period() as f64 * 1e-9)
+        Ok(self.pairs(device, queue)?[0])
+    }
+
+    /// Seconds between timestamps 2k and 2k + 1, for every pair.
+    fn pairs(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<f64>, GpuError> {
+        let bytes = read_back(device, &self.read, 8 * self.count as u64)?;
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
+        let period = queue.get_timestamp_period() as f64 * 1e-9;
+        Ok(ticks
+            .chunks_exact(2)
+            .map(|t| t[1].wrapping_sub(t[0]) as f64 * period)
+            .collect())
     }
 }
 
@@ -198,7 +255,11 @@ impl Buffers {
                 mapped_at_creation: false,
             })
         };
-        let params = buffer("params", 16, U::UNIFORM | U::COPY_DST);
+        let params = buffer(
+            "params",
+            std::mem::size_of::<Params>(),
+            U::UNIFORM | U::COPY_DST,
+        );
         let vertices = buffer(
             "vertices",
             vertex_cap * VERTEX_BYTES,
@@ -237,6 +298,7 @@ impl Buffers {
             read,
             bind,
             queries,
+            last_grid: None,
         }
     }
 }
@@ -293,21 +355,41 @@ fn read_back(device: &wgpu::Device, buffer: &wgpu::Buffer, len: u64) -> Result<V
 impl Kernel {
     /// Validates the shader with naga and builds the pipeline on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Kernel, GpuError> {
-        Kernel::build(device, 0, Layout::Indexed)
+        Kernel::with_options(device, KernelOptions::default())
     }
 
     /// The kernel for a given candidate [`Layout`].
     pub fn with_layout(device: &wgpu::Device, layout: Layout) -> Result<Kernel, GpuError> {
-        Kernel::build(device, 0, layout)
+        Kernel::with_options(
+            device,
+            KernelOptions {
+                layout,
+                ..KernelOptions::default()
+            },
+        )
     }
 
     /// A diagnostic for the benchmark: the kernel's memory accesses (indices, four vertex
     /// gathers, one write) with almost no arithmetic. Its output is not eta.
     pub fn memory_only(device: &wgpu::Device, layout: Layout) -> Result<Kernel, GpuError> {
-        Kernel::build(device, 1, layout)
+        Kernel::with_options(
+            device,
+            KernelOptions {
+                layout,
+                memory_only: true,
+                ..KernelOptions::default()
+            },
+        )
     }
 
-    fn build(device: &wgpu::Device, mode: u32, kind: Layout) -> Result<Kernel, GpuError> {
+    /// The kernel built with `options` (layout and launch shape).
+    pub fn with_options(device: &wgpu::Device, options: KernelOptions) -> Result<Kernel, GpuError> {
+        let max_wg = device.limits().max_compute_invocations_per_workgroup;
+        if !(1..=max_wg).contains(&options.workgroup) {
+            return Err(GpuError::TooLarge(format!(
+                "kernel options {options}: a workgroup holds 1 to {max_wg} invocations here"
+            )));
+        }
         shader::validate(shader::QUAD_QUALITY, shader::QUAD_QUALITY_PATH)?;
         let pipeline = checked(device, "building the quality pipeline", || {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -318,12 +400,15 @@ impl Kernel {
                 label: Some("quad_quality"),
                 layout: None,
                 module: &module,
-                entry_point: Some(match kind {
+                entry_point: Some(match options.layout {
                     Layout::Indexed => shader::ENTRY_POINT,
                     Layout::Local => shader::ENTRY_POINT_LOCAL,
                 }),
                 compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &[("MODE", mode as f64)],
+                    constants: &[
+                        ("MODE", u32::from(options.memory_only) as f64),
+                        ("WG", options.workgroup as f64),
+                    ],
                     ..Default::default()
                 },
                 cache: None,
@@ -336,7 +421,7 @@ impl Kernel {
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             max_chunk: usize::MAX,
             max_vertices: usize::MAX,
-            kind,
+            options,
             buffers: Mutex::new(None),
         })
     }
@@ -347,6 +432,11 @@ impl Kernel {
         self.max_chunk = max_chunk.max(1);
         self.max_vertices = max_vertices;
         self
+    }
+
+    /// How this kernel was built.
+    pub fn options(&self) -> KernelOptions {
+        self.options
     }
 
     /// True when the kernel time comes from timestamp queries.
@@ -376,13 +466,14 @@ impl Kernel {
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size) as usize;
         let wg_max = limits.max_compute_workgroups_per_dimension as usize;
-        let local = self.kind == Layout::Local;
+        let local = self.options.layout == Layout::Local;
+        let wg = self.options.workgroup as usize;
         let whole = local
             || batch.vertices.len() * VERTEX_BYTES <= bind_max
                 && batch.vertices.len() <= self.max_vertices;
         let per_candidate = if local { LOCAL_QUAD_BYTES } else { 16 };
         let mut chunk = (bind_max / per_candidate)
-            .min(wg_max.saturating_mul(wg_max).saturating_mul(WORKGROUP))
+            .min(wg_max.saturating_mul(wg_max).saturating_mul(wg))
             .min(self.max_chunk)
             .min(n);
         if !whole {
@@ -415,11 +506,11 @@ impl Kernel {
                     vertex_cap,
                     chunk,
                     self.timestamps,
-                    self.kind,
+                    self.options.layout,
                 )
             })?);
         }
-        let bufs = cache.as_ref().expect("just allocated");
+        let bufs = cache.as_mut().expect("just allocated");
         let (params_buf, vertex_buf, quad_buf, eta_buf, read_buf, bind) = (
             &bufs.params,
             &bufs.vertices,
@@ -429,6 +520,7 @@ impl Kernel {
             &bufs.bind,
         );
         let queries = bufs.queries.as_ref();
+        let mut last_grid = None;
 
         let mut out = Vec::with_capacity(n);
         let mut remap = if whole {
@@ -442,7 +534,7 @@ impl Kernel {
         for start in (0..n).step_by(chunk) {
             let count = chunk.min(n - start);
             let quads = &batch.quads[start..start + count];
-            let groups = count.div_ceil(WORKGROUP);
+            let groups = count.div_ceil(wg);
             let (gx, gy) = if groups <= wg_max {
                 (groups, 1)
             } else {
@@ -450,10 +542,11 @@ impl Kernel {
             };
             let params = Params {
                 count: count as u32,
-                row: (gx * WORKGROUP) as u32,
+                row: (gx * wg) as u32,
                 vertex_base: 0,
                 plane: count as u32,
             };
+            last_grid = Some((gx as u32, gy as u32));
 
             // Upload.
             let t = Instant::now();
@@ -529,8 +622,89 @@ impl Kernel {
         if queries.is_some() {
             timings.kernel_device_s = Some(device_s);
         }
+        bufs.last_grid = last_grid;
         Ok((out, timings))
     }
+
+    /// Device times (seconds) of `reps` dispatches of the last dispatch of the previous
+    /// [`Kernel::run`], on the data it left on the device, after `warm_up` of back-to-back
+    /// dispatches in the same submission: the kernel's time with the device busy. (A GPU
+    /// that was idle runs a lone dispatch at its idle clock: an H100 stayed at 345 MHz
+    /// through `run`'s single dispatches and reached 1980 MHz only under sustained work.)
+    /// `None` without timestamp queries or before a run.
+    pub fn dispatch_times(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        reps: u32,
+        warm_up: Duration,
+    ) -> Result<Option<Vec<f64>>, GpuError> {
+        let cache = self.buffers.lock().unwrap_or_else(|e| e.into_inner());
+        let Some((bufs, grid)) = cache.as_ref().and_then(|b| Some((b, b.last_grid?))) else {
+            return Ok(None);
+        };
+        timed_dispatches(
+            device,
+            queue,
+            &self.pipeline,
+            &bufs.bind,
+            grid,
+            reps,
+            warm_up,
+        )
+    }
+}
+
+/// Times `reps` dispatches of `pipeline` on `grid` (one compute pass each, timestamps around
+/// it) after about `warm_up` of untimed back-to-back dispatches, all in one submission; the
+/// warm-up count comes from one timed dispatch first. `None` without timestamp queries.
+fn timed_dispatches(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    pipeline: &wgpu::ComputePipeline,
+    bind: &wgpu::BindGroup,
+    (gx, gy): (u32, u32),
+    reps: u32,
+    warm_up: Duration,
+) -> Result<Option<Vec<f64>>, GpuError> {
+    let submit = |warm: u32, reps: u32| -> Result<Option<Vec<f64>>, GpuError> {
+        let Some(queries) = Timestamps::with_count(device, "dispatch times", 2 * reps) else {
+            return Ok(None);
+        };
+        let mut enc = device.create_command_encoder(&Default::default());
+        if warm > 0 {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bind, &[]);
+            for _ in 0..warm {
+                pass.dispatch_workgroups(gx, gy, 1);
+            }
+        }
+        for r in 0..reps {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("timed dispatch"),
+                timestamp_writes: Some(queries.writes(Some(2 * r), Some(2 * r + 1))),
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bind, &[]);
+            pass.dispatch_workgroups(gx, gy, 1);
+        }
+        queries.resolve(&mut enc);
+        checked(device, "running timed dispatches", || {
+            queue.submit([enc.finish()])
+        })?;
+        wait(device)?;
+        queries.pairs(device, queue).map(Some)
+    };
+    let warm = if warm_up.is_zero() {
+        0
+    } else {
+        let Some(first) = submit(0, 1)? else {
+            return Ok(None);
+        };
+        (warm_up.as_secs_f64() / first[0].max(1e-6)).ceil().min(1e5) as u32
+    };
+    submit(warm, reps.max(1))
 }
 
 /// Device memory bandwidth measured with a buffer-to-buffer copy of `bytes` bytes (read +
@@ -589,8 +763,9 @@ pub fn copy_bandwidth(
 }
 
 /// Device memory bandwidth reached by a compute kernel (`shaders/stream_copy.wgsl`, one
-/// vec4 per invocation) copying `bytes` bytes, read + write counted, in bytes per second:
-/// the fairest bound for the quality kernel, which goes through the same path.
+/// vec4 per invocation) copying `bytes` bytes, read + write counted, in bytes per second
+/// (the fastest of ten copies after half a second of back-to-back copies): the fairest bound for the quality kernel,
+/// which goes through the same path.
 pub fn stream_bandwidth(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -651,35 +826,25 @@ pub fn stream_bandwidth(
             },
         ],
     });
-    let mut best = f64::INFINITY;
-    for _ in 0..5 {
-        let queries = Timestamps::new(device, "stream copy time");
-        let t = Instant::now();
-        let mut enc = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("stream_copy"),
-                timestamp_writes: queries.as_ref().map(|q| q.writes(Some(0), Some(1))),
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups(gx as u32, gy as u32, 1);
-        }
-        if let Some(q) = &queries {
-            q.resolve(&mut enc);
-        }
-        checked(device, "running the stream-copy kernel", || {
-            queue.submit([enc.finish()])
-        })?;
-        wait(device)?;
-        let mut s = t.elapsed().as_secs_f64();
-        if let Some(q) = &queries {
-            let d = q.seconds(device, queue)?;
-            if d > 0.0 {
-                s = d;
+    // Ten timed copies after half a second of untimed ones (clocks up, as for
+    // `Kernel::dispatch_times`); without timestamps, the host clock over one.
+    let grid = (gx as u32, gy as u32);
+    let warm_up = Duration::from_millis(500);
+    let t = Instant::now();
+    let best = match timed_dispatches(device, queue, &pipeline, &bind, grid, 10, warm_up)? {
+        Some(times) => times.into_iter().fold(f64::INFINITY, f64::min),
+        None => {
+            let mut enc = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.dispatch_workgroups(grid.0, grid.1, 1);
             }
+            queue.submit([enc.finish()]);
+            wait(device)?;
+            t.elapsed().as_secs_f64()
         }
-        best = best.min(s);
-    }
+    };
     Ok(2.0 * bytes as f64 / best)
 }

@@ -19,8 +19,8 @@ pub mod shader;
 pub mod synthetic;
 
 pub use device::{
-    Kernel, Layout, Timings, adapter_name, adapters, copy_bandwidth, evaluate, is_software,
-    open_device, stream_bandwidth,
+    Kernel, KernelOptions, Layout, Timings, adapter_name, adapters, copy_bandwidth, evaluate,
+    is_software, open_device, stream_bandwidth,
 };
 pub use layout::Batch;
 

@@ -6,7 +6,9 @@
 //! when `CI` is set: then they fail.
 
 use crate::util::{SEED, repo_path};
-use quadrecomb::gpu::{self, Backend, Batch, Evaluator, Kernel, Layout, layout::Vertex};
+use quadrecomb::gpu::{
+    self, Backend, Batch, Evaluator, Kernel, KernelOptions, Layout, layout::Vertex,
+};
 use quadrecomb::mesh::{Mesh, MeshData};
 use quadrecomb::quality::{self, CandidateTable};
 use rand::{RngExt, SeedableRng};
@@ -534,6 +536,55 @@ fn chunked_dispatches_and_vertex_compaction_give_identical_results() {
     assert_eq!(c, local_whole);
     let empty = d.kernel.run(&d.device, &d.queue, &Batch::new()).unwrap().0;
     assert!(empty.is_empty());
+}
+
+#[test]
+fn launch_shapes_give_identical_results() {
+    let Some(d) = dev() else { return };
+    let mesh = jittered_grid_mesh(23, 0.3, |x, y| 0.1 * x * y, SEED + 5);
+    let mut batch = Batch::new();
+    batch
+        .push(&mesh.vertices, &CandidateTable::topology_only(&mesh).quads)
+        .unwrap();
+    let (indexed, _) = d.kernel.run(&d.device, &d.queue, &batch).unwrap();
+    let (local, _) = d.local.run(&d.device, &d.queue, &batch).unwrap();
+    for layout in [Layout::Indexed, Layout::Local] {
+        let want = if layout == Layout::Indexed {
+            &indexed
+        } else {
+            &local
+        };
+        // Workgroup sizes that leave partial last workgroups; chunks of 997
+        // candidates (a prime) make every chunk's tail differ.
+        for (workgroup, chunk) in [(64, usize::MAX), (32, usize::MAX), (128, 997), (1, 997)] {
+            let options = KernelOptions {
+                layout,
+                workgroup,
+                memory_only: false,
+            };
+            let k = Kernel::with_options(&d.device, options)
+                .unwrap()
+                .with_caps(chunk, usize::MAX);
+            let (got, _) = k.run(&d.device, &d.queue, &batch).unwrap();
+            assert_eq!(&got, want, "{options}");
+            if let Some(times) = k
+                .dispatch_times(&d.device, &d.queue, 3, std::time::Duration::from_millis(5))
+                .unwrap()
+            {
+                assert_eq!(times.len(), 3);
+                assert!(
+                    times.iter().all(|t| t.is_finite() && *t >= 0.0),
+                    "{times:?}"
+                );
+            }
+        }
+    }
+    let too_many = KernelOptions {
+        workgroup: d.device.limits().max_compute_invocations_per_workgroup + 1,
+        ..KernelOptions::default()
+    };
+    let err = Kernel::with_options(&d.device, too_many).unwrap_err();
+    assert!(err.to_string().contains("invocations here"), "{err}");
 }
 
 #[test]

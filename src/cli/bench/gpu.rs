@@ -4,7 +4,7 @@
 
 use anyhow::Context;
 use quadrecomb::gpu::layout::LOCAL_QUAD_BYTES;
-use quadrecomb::gpu::{self, Batch, Kernel, Layout, Timings, synthetic};
+use quadrecomb::gpu::{self, Batch, Kernel, KernelOptions, Layout, Timings, synthetic};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -26,6 +26,17 @@ pub struct Args {
     /// Seed of the jittered grid.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Dispatches timed per kernel for the warm kernel time (their median).
+    #[arg(long, default_value_t = 20)]
+    dispatches: u32,
+    /// Untimed back-to-back dispatches before those, in milliseconds of device time, so the
+    /// GPU runs at its working clock (an idle H100 stays at 345 MHz for lone dispatches).
+    #[arg(long, default_value_t = 1000)]
+    warm_up_ms: u64,
+    /// Also compare launch shapes (layout x workgroup size, and the memory-only
+    /// diagnostics) at the largest size, on every adapter.
+    #[arg(long)]
+    shapes: bool,
 }
 
 fn parse_count(s: &str) -> Result<usize, String> {
@@ -43,7 +54,17 @@ struct Row {
     t: Timings,
     total_s: f64,
     max_diff_f64: Option<f64>,
-    bound_pct: Option<f64>,
+    /// Median device time of dispatches after a warm-up (seconds), where measured.
+    warm_s: Option<f64>,
+    /// Bytes per candidate of this row's kernel (the bound's numerator).
+    bytes: Option<f64>,
+    /// The device's measured bandwidth (the bound's denominator), bytes per second.
+    bw: Option<f64>,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
 }
 
 fn best_of<T>(
@@ -69,6 +90,7 @@ fn max_diff(eta: &[f32], reference: &[f64]) -> f64 {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let threads = rayon::current_num_threads();
+    let warm_up = std::time::Duration::from_millis(args.warm_up_ms);
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -189,7 +211,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 t,
                 total_s: total,
                 max_diff_f64: Some(max_diff(&eta, &reference)),
-                bound_pct: None,
+                warm_s: None,
+                bytes: None,
+                bw: None,
             })
         };
         if c <= args.serial_max {
@@ -210,7 +234,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 },
                 total_s: e,
                 max_diff_f64: Some(0.0),
-                bound_pct: None,
+                warm_s: None,
+                bytes: None,
+                bw: None,
             });
             rows.push(cpu_row("cpu-twin, 1 thread".into(), &|| {
                 one.install(|| gpu::cpu::quad_quality(&batch))
@@ -233,52 +259,127 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     let (eta, t) = k.run(device, queue, &batch)?;
                     Ok((eta, t, s.elapsed().as_secs_f64()))
                 })?;
-                let achieved = c as f64 * bytes / t.kernel_best_s();
+                let warm = k
+                    .dispatch_times(device, queue, args.dispatches, warm_up)?
+                    .map(median);
                 rows.push(Row {
                     backend: label,
                     candidates: c,
                     t,
                     total_s: total,
                     max_diff_f64: is_eta.then(|| max_diff(&eta, &reference)),
-                    bound_pct: Some(100.0 * achieved / bw),
+                    warm_s: warm,
+                    bytes: Some(bytes),
+                    bw: Some(*bw),
                 });
             }
         }
         print_rows(
             &rows[rows.len() - rows.iter().rev().take_while(|r| r.candidates == c).count()..],
         );
+        if args.shapes && Some(&size) == args.sizes.iter().max() {
+            for (name, device, queue, _, bw) in &devices {
+                shapes(name, device, queue, &batch, *bw, args.dispatches, warm_up)?;
+            }
+        }
     }
     println!("\nAll sizes:");
     print_rows(&rows);
     println!(
-        "\nkernel = device timestamps where supported (else submit + wait); total = upload + \
-         kernel + readback on the host clock, batch preparation excluded; bound = kernel bytes \
-         per second (bytes per candidate above) / the better measured bandwidth."
+        "\nkernel = the one dispatch of a run, after its upload (device timestamps where \
+         supported, else submit + wait), at whatever clock the GPU is at; warm = median of \
+         {} dispatches after {} ms of back-to-back ones (the GPU at its working clock); total \
+         = upload + kernel + readback on the host clock, batch preparation excluded; \
+         Mcand/s kernel and the bound use the warm time where there is one; bound = kernel \
+         bytes per second (bytes per candidate above) / the better measured bandwidth.",
+        args.dispatches, args.warm_up_ms
     );
     Ok(ExitCode::SUCCESS)
 }
 
 fn print_rows(rows: &[Row]) {
     println!(
-        "| backend | candidates | upload ms | kernel ms | readback ms | total ms | \
-         Mcand/s kernel | Mcand/s total | % of bandwidth bound | max abs diff vs f64 |"
+        "| backend | candidates | upload ms | kernel ms, one dispatch | kernel ms, warm | readback ms | \
+         total ms | Mcand/s kernel | Mcand/s total | % of bandwidth bound | \
+         max abs diff vs f64 |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let dash = || "-".to_string();
     for r in rows {
         let k = r.t.kernel_best_s();
+        // Throughput and bound from the warm time where there is one.
+        let kt = r.warm_s.unwrap_or(k);
+        let bound = r
+            .bytes
+            .zip(r.bw)
+            .map(|(b, bw)| 100.0 * r.candidates as f64 * b / kt / bw);
         println!(
-            "| {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} | {:.1} | {} | {} |",
+            "| {} | {} | {:.3} | {:.3} | {} | {:.3} | {:.3} | {:.1} | {:.1} | {} | {} |",
             r.backend,
             r.candidates,
             r.t.upload_s * 1e3,
             k * 1e3,
+            r.warm_s.map_or_else(dash, |s| format!("{:.3}", s * 1e3)),
             r.t.readback_s * 1e3,
             r.total_s * 1e3,
-            r.candidates as f64 / k / 1e6,
+            r.candidates as f64 / kt / 1e6,
             r.candidates as f64 / r.total_s / 1e6,
-            r.bound_pct.map_or("-".to_string(), |p| format!("{p:.0}%")),
-            r.max_diff_f64
-                .map_or("-".to_string(), |d| format!("{d:.1e}"))
+            bound.map_or_else(dash, |p| format!("{p:.0}%")),
+            r.max_diff_f64.map_or_else(dash, |d| format!("{d:.1e}"))
         );
     }
+}
+
+/// The launch-shape comparison (`--shapes`): every layout x workgroup size, eta and
+/// memory-only, on `batch`; warm median and best dispatch.
+fn shapes(
+    name: &str,
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    batch: &Batch,
+    bw: f64,
+    dispatches: u32,
+    warm_up: std::time::Duration,
+) -> anyhow::Result<()> {
+    let c = batch.len() as f64;
+    println!(
+        "\nLaunch shapes on {name}, {} candidates, {dispatches} dispatches each after {} ms \
+         of warm-up:",
+        batch.len(),
+        warm_up.as_millis()
+    );
+    println!("| kernel | median ms | best ms | Gcand/s | % of bandwidth bound |");
+    println!("|---|---:|---:|---:|---:|");
+    let max_wg = device.limits().max_compute_invocations_per_workgroup;
+    for layout in [Layout::Indexed, Layout::Local] {
+        let bytes = match layout {
+            Layout::Indexed => batch.bytes_per_candidate(),
+            Layout::Local => (LOCAL_QUAD_BYTES + 4) as f64,
+        };
+        for memory_only in [false, true] {
+            for workgroup in [64, 256, 1024].into_iter().filter(|&w| w <= max_wg) {
+                let options = KernelOptions {
+                    layout,
+                    workgroup,
+                    memory_only,
+                };
+                let k = Kernel::with_options(device, options)?;
+                k.run(device, queue, batch)?;
+                let Some(times) = k.dispatch_times(device, queue, dispatches, warm_up)? else {
+                    println!("| {options} | no timestamps | | | |");
+                    continue;
+                };
+                let best = times.iter().copied().fold(f64::INFINITY, f64::min);
+                let med = median(times);
+                println!(
+                    "| {options} | {:.4} | {:.4} | {:.2} | {:.0}% |",
+                    med * 1e3,
+                    best * 1e3,
+                    c / med / 1e9,
+                    100.0 * c * bytes / med / bw
+                );
+            }
+        }
+    }
+    Ok(())
 }
