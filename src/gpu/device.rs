@@ -152,8 +152,9 @@ struct Buffers {
     read: wgpu::Buffer,
     bind: wgpu::BindGroup,
     queries: Option<Timestamps>,
-    /// The grid of the last dispatch (what [`Kernel::dispatch_times`] repeats).
-    last_grid: Option<(u32, u32)>,
+    /// The grid of the last run when it was a single dispatch (what
+    /// [`Kernel::dispatch_times`] repeats).
+    single_grid: Option<(u32, u32)>,
 }
 
 /// Device timestamps around compute passes (pairs: 0 and 1 around one pass, ...): the query
@@ -298,7 +299,7 @@ impl Buffers {
             read,
             bind,
             queries,
-            last_grid: None,
+            single_grid: None,
         }
     }
 }
@@ -622,16 +623,18 @@ impl Kernel {
         if queries.is_some() {
             timings.kernel_device_s = Some(device_s);
         }
-        bufs.last_grid = last_grid;
+        // Only a single dispatch's data is all still on the device.
+        bufs.single_grid = last_grid.filter(|_| timings.dispatches == 1);
         Ok((out, timings))
     }
 
-    /// Device times (seconds) of `reps` dispatches of the last dispatch of the previous
-    /// [`Kernel::run`], on the data it left on the device, after `warm_up` of back-to-back
-    /// dispatches in the same submission: the kernel's time with the device busy. (A GPU
-    /// that was idle runs a lone dispatch at its idle clock: an H100 stayed at 345 MHz
-    /// through `run`'s single dispatches and reached 1980 MHz only under sustained work.)
-    /// `None` without timestamp queries or before a run.
+    /// Device times (seconds) of `reps` dispatches of the previous [`Kernel::run`] (when it
+    /// was a single dispatch), on the data it left on the device, after `warm_up` of
+    /// back-to-back dispatches in the same submission: the kernel's time with the device
+    /// busy. (A GPU that was idle runs a lone dispatch at its idle clock: an H100 stayed at
+    /// 345 MHz through `run`'s single dispatches and reached 1980 MHz only under sustained
+    /// work.) `None` without timestamp queries, before a run, or after a run of several
+    /// dispatches (the device holds only the last one's data).
     pub fn dispatch_times(
         &self,
         device: &wgpu::Device,
@@ -640,7 +643,7 @@ impl Kernel {
         warm_up: Duration,
     ) -> Result<Option<Vec<f64>>, GpuError> {
         let cache = self.buffers.lock().unwrap_or_else(|e| e.into_inner());
-        let Some((bufs, grid)) = cache.as_ref().and_then(|b| Some((b, b.last_grid?))) else {
+        let Some((bufs, grid)) = cache.as_ref().and_then(|b| Some((b, b.single_grid?))) else {
             return Ok(None);
         };
         timed_dispatches(

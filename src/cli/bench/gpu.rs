@@ -286,12 +286,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     println!("\nAll sizes:");
     print_rows(&rows);
     println!(
-        "\nkernel = the one dispatch of a run, after its upload (device timestamps where \
-         supported, else submit + wait), at whatever clock the GPU is at; warm = median of \
-         {} dispatches after {} ms of back-to-back ones (the GPU at its working clock); total \
-         = upload + kernel + readback on the host clock, batch preparation excluded; \
-         Mcand/s kernel and the bound use the warm time where there is one; bound = kernel \
-         bytes per second (bytes per candidate above) / the better measured bandwidth.",
+        "\nkernel, run = the run's dispatch (or dispatches, each after its upload), device \
+         timestamps where supported, else submit + wait, at whatever clock the GPU is at; \
+         warm = median of {} dispatches after {} ms of back-to-back ones (the GPU at its \
+         working clock; only for a single-dispatch run); total = upload + kernel + readback \
+         on the host clock, batch preparation excluded; Mcand/s kernel and the bound use the \
+         warm time where there is one; bound = kernel bytes per second (bytes per candidate \
+         above) / the better measured bandwidth.",
         args.dispatches, args.warm_up_ms
     );
     Ok(ExitCode::SUCCESS)
@@ -299,7 +300,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
 fn print_rows(rows: &[Row]) {
     println!(
-        "| backend | candidates | upload ms | kernel ms, one dispatch | kernel ms, warm | readback ms | \
+        "| backend | candidates | upload ms | kernel ms, run | kernel ms, warm | readback ms | \
          total ms | Mcand/s kernel | Mcand/s total | % of bandwidth bound | \
          max abs diff vs f64 |"
     );
