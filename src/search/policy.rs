@@ -9,12 +9,61 @@ use rand_chacha::ChaCha8Rng;
 /// Uniform pick in `0..n` (n > 0) from a ChaCha8 stream: the top 64 bits of `u64 * n`,
 /// portable and the same on every platform.
 fn pick_from(rng: &mut ChaCha8Rng, n: usize) -> usize {
-    ((rng.next_u64() as u128 * n as u128) >> 64) as usize
+    pick_with(rng.next_u64(), n)
+}
+
+/// Uniform pick in `0..n` (n > 0) from the 64-bit number `x`: the top 64 bits of `x * n`.
+fn pick_with(x: u64, n: usize) -> usize {
+    ((x as u128 * n as u128) >> 64) as usize
+}
+
+/// The random number of the selective tree's node reached from the node keyed `parent` by
+/// action `c`: SplitMix64's finaliser of `parent ^ (c + 1) * golden ratio`. Each node's draw
+/// depends on its path alone, not on what the search explored before it, so pruning and
+/// the order children are visited in cannot change any draw (or the decision).
+pub fn node_key(parent: u64, c: u32) -> u64 {
+    let mut z = parent ^ (u64::from(c) + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// Slack added to branch-and-bound upper bounds so that rounding never prunes a sequence
 /// whose value could tie or beat the best (keeps the result identical to exhaustive search).
 const BOUND_SLACK: f64 = 1e-9;
+
+/// Branch and bound of one selective tree: the best leaf value found so far (rewards summed
+/// from the root, in path order). Rewards are at most 1, so a node at depth `d` whose path
+/// sums to `partial` has no leaf above `partial + (h - d)`; when that is below the best
+/// (by more than `BOUND_SLACK`, which covers the rounding of sums taken in another order),
+/// nothing below it can be the best, nor tie with it.
+struct Bound {
+    h: u32,
+    best: f64,
+}
+
+impl Bound {
+    fn new(h: u32) -> Bound {
+        Bound {
+            h,
+            best: f64::NEG_INFINITY,
+        }
+    }
+
+    fn leaf(&mut self, value: f64) {
+        if value > self.best {
+            self.best = value;
+        }
+    }
+
+    fn prunes(&self, partial: f64, d: u32) -> bool {
+        let mut top = partial;
+        for _ in d..self.h {
+            top += 1.0;
+        }
+        top + BOUND_SLACK < self.best
+    }
+}
 
 impl Searcher<'_> {
     /// Uniform pick in `0..n` (n > 0) from the run's ChaCha8 stream, portable.
@@ -250,16 +299,25 @@ impl Searcher<'_> {
             self.nodes += 1;
             self.trees += 1;
             self.state.tree_begin();
-            let mut best = f64::NEG_INFINITY;
-            let mut first = NONE;
-            for c in table.by_triangle[t as usize] {
-                if c == NONE || !self.state.is_allowed(c) {
-                    continue;
+            let key = self.rng.next_u64();
+            // Children in decreasing reward, so good leaves come first and bound the rest;
+            // ties between the root's children still go to the first in `by_triangle`.
+            let mut kids = [(-1.0, 0, NONE); 3];
+            for (slot, c) in table.by_triangle[t as usize].into_iter().enumerate() {
+                if c != NONE && self.state.is_allowed(c) {
+                    kids[slot] = (table.eta[c as usize], slot, c);
                 }
-                let v = table.eta[c as usize] + self.selective_child(c, 1, h);
-                if v > best {
-                    best = v;
-                    first = c;
+            }
+            kids.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let mut bound = Bound::new(h);
+            let (mut best, mut first, mut first_slot) = (f64::NEG_INFINITY, NONE, usize::MAX);
+            for (eta, slot, c) in kids {
+                if c == NONE {
+                    break;
+                }
+                let v = eta + self.selective_child(c, key, 1, eta, &mut bound);
+                if v > best || (v == best && slot < first_slot) {
+                    (best, first, first_slot) = (v, c, slot);
                 }
             }
             debug_assert!(first != NONE, "a triangle of P_min has an allowed action");
@@ -268,30 +326,51 @@ impl Searcher<'_> {
     }
 
     /// Value of the best leaf below the child reached by action `c` at depth `d` (the reward
-    /// of `c` excluded).
-    fn selective_child(&mut self, c: u32, d: u32, h: u32) -> f64 {
-        if d == h {
+    /// of `c` excluded), or minus infinity when `bound` proves that no leaf there can reach
+    /// the best leaf found so far. `parent` is the key of the node `c` leaves, `partial` the
+    /// rewards from the root down to `c` included.
+    fn selective_child(
+        &mut self,
+        c: u32,
+        parent: u64,
+        d: u32,
+        partial: f64,
+        bound: &mut Bound,
+    ) -> f64 {
+        if d == bound.h {
+            bound.leaf(partial);
             return 0.0;
         }
+        if bound.prunes(partial, d) {
+            return f64::NEG_INFINITY;
+        }
         self.state.tree_push(c);
-        let v = self.selective_node(d, h);
+        let v = self.selective_node(node_key(parent, c), d, partial, bound);
         self.state.tree_pop();
         v
     }
 
-    /// Best summed reward below the current node at depth `d < h`.
-    fn selective_node(&mut self, d: u32, h: u32) -> f64 {
+    /// Best summed reward below the current node at depth `d < h`, keyed `key`.
+    fn selective_node(&mut self, key: u64, d: u32, partial: f64, bound: &mut Bound) -> f64 {
         let table = self.state.table();
-        let Some((t, allowed)) = self.choose_triangle() else {
+        let Some((t, allowed)) = self.choose_triangle(key) else {
+            bound.leaf(partial);
             return 0.0;
         };
         self.nodes += 1;
-        let mut best = f64::NEG_INFINITY;
+        let mut kids = [(-1.0, NONE); 3];
         for (i, c) in table.by_triangle[t as usize].into_iter().enumerate() {
-            if allowed & (1 << i) == 0 {
-                continue;
+            if allowed & (1 << i) != 0 {
+                kids[i] = (table.eta[c as usize], c);
             }
-            let v = table.eta[c as usize] + self.selective_child(c, d + 1, h);
+        }
+        kids.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let mut best = f64::NEG_INFINITY;
+        for (eta, c) in kids {
+            if c == NONE {
+                break;
+            }
+            let v = eta + self.selective_child(c, key, d + 1, partial + eta, bound);
             if v > best {
                 best = v;
             }
@@ -303,7 +382,7 @@ impl Searcher<'_> {
     /// `by_triangle[t][i]`): uniformly from the first non-empty `P_k ∩ N` (N: recombinable
     /// triangles across an edge of a quad of the path, in path then side order), else from
     /// `P_min` (in increasing id).
-    fn choose_triangle(&mut self) -> Option<(u32, u8)> {
+    fn choose_triangle(&mut self, key: u64) -> Option<(u32, u8)> {
         self.near.clear();
         let mut kmin = u8::MAX;
         for slot in self.state.tree_near() {
@@ -319,11 +398,10 @@ impl Searcher<'_> {
             }
         }
         if !self.near.is_empty() {
-            let i = self.pick(self.near.len());
+            let i = pick_with(key, self.near.len());
             return Some((self.near[i].t, self.near[i].allowed));
         }
-        let rng = &mut self.rng;
-        let t = self.state.tree_pick_pmin(|n| pick_from(rng, n))?;
+        let t = self.state.tree_pick_pmin(|n| pick_with(key, n))?;
         Some((t, self.state.tree_allowed_mask(t)))
     }
 }

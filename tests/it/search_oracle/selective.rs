@@ -1,8 +1,12 @@
 //! The selective look-ahead tree replayed naively: the same tree (section 5 of the paper, as
 //! `docs/search.md` states it) built on the naive oracle, with the same random draws (one
-//! ChaCha8 stream, `pick(n)` = top 64 bits of `u64 * n`, `P_min` and `P_k` in increasing
-//! triangle id, `N` in path then side order), must choose exactly the same actions as
-//! `Searcher` for every seed and horizon.
+//! ChaCha8 stream for the root triangles and one key per tree; below the root, each node's
+//! draw is its path's key, `key(child) = splitmix64_finaliser(key(parent) ^ (c + 1) *
+//! 0x9E3779B97F4A7C15)`; `pick(x, n)` = top 64 bits of `x * n`; `P_min` and `P_k` in
+//! increasing triangle id, `N` in path then side order), must choose exactly the same
+//! actions as `Searcher` for every seed and horizon. The replay visits every node, in
+//! `by_triangle` order; `Searcher` visits children by decreasing reward and cuts subtrees by
+//! branch and bound, which must change nothing.
 
 use super::meshes::{self, Diagonals, Grid};
 use super::naive::Naive;
@@ -21,12 +25,29 @@ struct Replay<'a> {
     rng: ChaCha8Rng,
     /// Actions applied inside the current tree.
     path: Vec<u32>,
+    /// Keys of the nodes of the path (the tree's key first).
+    keys: Vec<u64>,
     h: u32,
 }
 
+fn pick(x: u64, n: usize) -> usize {
+    ((x as u128 * n as u128) >> 64) as usize
+}
+
+fn child_key(parent: u64, c: u32) -> u64 {
+    let mut z = parent ^ (c as u64 + 1).wrapping_mul(0x9E3779B97F4A7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
+    z ^ (z >> 31)
+}
+
 impl Replay<'_> {
+    /// The draw of the current node: the run's stream at the root, the node's key below.
     fn pick(&mut self, n: usize) -> usize {
-        ((self.rng.next_u64() as u128 * n as u128) >> 64) as usize
+        match self.keys.last() {
+            Some(&key) => pick(key, n),
+            None => pick(self.rng.next_u64(), n),
+        }
     }
 
     fn count(&self, t: u32) -> u32 {
@@ -104,7 +125,10 @@ impl Replay<'_> {
         }
         self.oracle.apply(c);
         self.path.push(c);
+        let key = child_key(*self.keys.last().expect("inside a tree"), c);
+        self.keys.push(key);
         let v = self.node(d);
+        self.keys.pop();
         self.path.pop();
         self.oracle.undo();
         v
@@ -141,6 +165,7 @@ impl Replay<'_> {
             }
             let mut best = f64::NEG_INFINITY;
             let mut first = NONE;
+            self.keys = vec![self.rng.next_u64()];
             for c in self.table.by_triangle[t as usize] {
                 if c != NONE && self.oracle.is_allowed(c) {
                     let v = self.table.eta[c as usize] + self.child(c, 1);
@@ -150,6 +175,7 @@ impl Replay<'_> {
                     }
                 }
             }
+            self.keys.clear();
             self.oracle.apply(first);
             chosen.push(first);
         }
@@ -164,6 +190,7 @@ fn naive_selective(mesh: &Mesh, table: &CandidateTable, h: u32, seed: u64) -> Ve
         oracle: Naive::new(mesh, table),
         rng: ChaCha8Rng::seed_from_u64(seed),
         path: Vec::new(),
+        keys: Vec::new(),
         h,
     }
     .run()
