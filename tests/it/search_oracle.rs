@@ -417,6 +417,7 @@ fn harness_reports_verdicts_changed_far_away() {
             WalkConfig {
                 explorations: 0,
                 max_depth: 1,
+                ..WalkConfig::default()
             },
         )
         .is_err()

@@ -246,6 +246,7 @@ impl State<'_> {
                     } else {
                         self.queue[s].len()
                     };
+                    self.finished[s] = gdone[g];
                 }
                 return Verdict {
                     fin_odd: odd as u8,
@@ -284,6 +285,15 @@ impl State<'_> {
         let off = arena.len();
         if kind == KIND_DISTINCT {
             arena.extend_from_slice(&self.arc_roots[..self.narcs]);
+        } else if kind == KIND_SPLIT {
+            // The finished parts first (`fin_known` triangles), then the running part's.
+            for fin in [true, false] {
+                for s in 0..self.nsearch {
+                    if self.finished[s] == fin {
+                        arena.extend_from_slice(&self.queue[s][..self.cert_len[s]]);
+                    }
+                }
+            }
         } else if kind != KIND_LOCAL {
             for s in 0..self.nsearch {
                 arena.extend_from_slice(&self.queue[s][..self.cert_len[s]]);

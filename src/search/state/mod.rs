@@ -203,6 +203,13 @@ pub struct State<'a> {
     /// Forward mode (`set_forward`) and the initial state it resets to.
     forward: bool,
     initial: Option<Box<Initial>>,
+    /// The last action applied, when every verdict was exact before it and it had a local
+    /// proof (its remaining neighbours stay joined around its clean vertices): what
+    /// [`State::shrink_split`] needs. `NONE` otherwise.
+    last_local: u32,
+    /// The clean quad vertices (bits) of `last_local`'s proof.
+    last_local_mask: u8,
+
     // ---- scratch ----
     /// Search marks: `epoch << 3 | owner` (owner = search index or `BLOCKED`) for a triangle
     /// visited by the current search, lower for an unvisited one, `DEAD` for a used one.
@@ -214,14 +221,20 @@ pub struct State<'a> {
     nseed: [usize; 4],
     /// How much of each queue the verdict depends on (its certificate).
     cert_len: [usize; 4],
+    /// Split: whether each search's group finished (its queue is a whole part).
+    finished: [bool; 4],
     group: [u8; 4],
     nsearch: usize,
     changed: Vec<u32>,
     moved: Vec<u32>,
+    /// Fan triangles for [`State::shrink_split`].
+    fan: Vec<u32>,
     /// Number of criterion checks that needed a search (statistics).
     pub searches: u64,
     /// Number of triangles those searches visited.
     pub searched: u64,
+    /// Split verdicts kept by [`State::shrink_split`] instead of a new search (statistics).
+    pub split_shrinks: u64,
 }
 
 impl<'a> State<'a> {
@@ -384,18 +397,23 @@ impl<'a> State<'a> {
             tree: Overlay::new(m, nv, ring),
             forward: false,
             initial: None,
+            last_local: NONE,
+            last_local_mask: 0,
             stamp: vec![0; nt],
             epoch: 0,
             queue: Default::default(),
             head: [0; 4],
             nseed: [0; 4],
             cert_len: [0; 4],
+            finished: [false; 4],
             group: [0; 4],
             nsearch: 0,
             changed: Vec::new(),
             moved: Vec::new(),
+            fan: Vec::new(),
             searches: 0,
             searched: 0,
+            split_shrinks: 0,
         };
         // The removed region at the start: boundary edges (mesh, surface and quad
         // boundaries: dual sides without a neighbour) and input quads.
@@ -533,6 +551,9 @@ impl<'a> State<'a> {
 
     /// Recomputes the verdict of live candidate `c` and records its certificate.
     fn recheck_one(&mut self, c: u32) {
+        if self.shrink_split(c) {
+            return;
+        }
         let mut r = self.check(c);
         let ci = c as usize;
         let old = self.verdict[ci];
@@ -586,6 +607,127 @@ impl<'a> State<'a> {
             self.split_pos[ci] = NONE;
             self.base_log(Op::SplitRem { c, pos: p });
         }
+    }
+
+    /// Keeps the split verdict of `c` without a new search when the only change since it
+    /// was exact is the last action `y`, applied with a local proof, sharing no vertex
+    /// with `c`, inside one of the parts `c` would leave. That part minus `y`'s pair is
+    /// still one part: `y`'s remaining neighbours stay joined through the fans of its clean
+    /// vertices, which hold no triangle of `c` (no shared vertex) and no used one. Its
+    /// parity is unchanged (two triangles fewer), and so is the verdict. The certificate
+    /// drops the pair: a finished part's list is the whole part again (rewritten in place
+    /// when it was written after the initial state, else copied); the running part's paths
+    /// along which its searches met gain those fans, through which they still meet
+    /// (copied). Forward mode only (nothing to undo). A split verdict's certificate lists
+    /// its finished parts first, `fin_known` triangles in all.
+    fn shrink_split(&mut self, c: u32) -> bool {
+        let y = self.last_local;
+        if y == NONE || !self.forward || self.chosen.last() != Some(&y) {
+            return false;
+        }
+        let ci = c as usize;
+        let v = self.verdict[ci];
+        if v.kind != KIND_SPLIT {
+            return false;
+        }
+        let (qc, qy) = (self.table.quads[ci], self.table.quads[y as usize]);
+        if qc.iter().any(|a| qy.contains(a)) {
+            return false;
+        }
+        let [a, b] = self.table.pairs[y as usize];
+        let (off, fin, len) = (v.cert as usize, v.fin_known as usize, v.cert_len as usize);
+        let cert = &self.base_cert[off..off + len];
+        let keep = |t: &u32| *t != a && *t != b;
+        let (off, len, fin_known) = if let Some(ia) = cert[..fin].iter().position(|&t| t == a) {
+            let ib = cert[..fin].iter().position(|&t| t == b);
+            let ib = ib.expect("both triangles of a pair are in the same part");
+            let (lo, hi) = (ia.min(ib), ia.max(ib));
+            if off >= self.base_cert_init {
+                // Swap the pair to the end of the finished parts, then close the gap.
+                let arena = &mut self.base_cert;
+                arena.swap(off + hi, off + fin - 1);
+                arena.swap(off + lo, off + fin - 2);
+                arena.copy_within(off + fin..off + len, off + fin - 2);
+                (off, len - 2, v.fin_known - 2)
+            } else {
+                let new = self.base_cert.len();
+                for i in off..off + len {
+                    let t = self.base_cert[i];
+                    if keep(&t) {
+                        self.base_cert.push(t);
+                    }
+                }
+                (new, len - 2, v.fin_known - 2)
+            }
+        } else {
+            if !cert[fin..].iter().any(|t| !keep(t)) || !self.fans(y, self.last_local_mask) {
+                return false;
+            }
+            let new = self.base_cert.len();
+            self.base_cert.extend_from_within(off..off + fin);
+            for i in off + fin..off + len {
+                let t = self.base_cert[i];
+                if keep(&t) {
+                    self.base_cert.push(t);
+                }
+            }
+            let ver = self.cert_ver[ci];
+            for i in 0..self.fan.len() {
+                let t = self.fan[i];
+                self.base_cert.push(t);
+                self.watch_push(t, c, ver);
+            }
+            (new, self.base_cert.len() - new, v.fin_known)
+        };
+        self.verdict[ci] = Verdict {
+            cert: off as u32,
+            cert_len: len as u32,
+            fin_known,
+            ..v
+        };
+        self.split_shrinks += 1;
+        true
+    }
+
+    /// The triangles around the clean quad vertices `mask` of candidate `y` (both of its
+    /// triangles remaining), `y`'s own excepted, into `self.fan`; false when a fan does not
+    /// close within 64 steps.
+    fn fans(&mut self, y: u32, mask: u8) -> bool {
+        self.fan.clear();
+        let [a, b] = self.table.pairs[y as usize];
+        let q = self.table.quads[y as usize];
+        let nb = &self.mesh.topology.neighbours;
+        let tris = &self.mesh.triangles;
+        for (i, &v) in q.iter().enumerate() {
+            if mask & (1 << i) == 0 {
+                continue;
+            }
+            let start = if tris[a as usize].contains(&v) { a } else { b };
+            // Walk around v: leave each triangle across its other edge at v.
+            let (mut t, mut prev) = (start, NONE);
+            for _ in 0..64 {
+                let tri = tris[t as usize];
+                let k = tri.iter().position(|&x| x == v).expect("v is a corner");
+                // Edges at v: (tri[k], tri[k+1]) is side k, (tri[k-1], tri[k]) side k-1.
+                let (s1, s2) = (nb[t as usize][k], nb[t as usize][(k + 2) % 3]);
+                let next = if s1 != prev { s1 } else { s2 };
+                if next == NONE {
+                    return false;
+                }
+                prev = t;
+                t = next;
+                if t == start {
+                    break;
+                }
+                if t != a && t != b && !self.fan.contains(&t) {
+                    self.fan.push(t);
+                }
+            }
+            if t != start {
+                return false;
+            }
+        }
+        true
     }
 
     /// Logs a change of the base state for `undo`; forward mode undoes nothing and keeps
@@ -735,11 +877,19 @@ impl<'a> State<'a> {
         // An exact verdict that found one part needs no new search; a split does (its
         // parts are relabelled).
         let v = self.verdict[ci];
-        let split = if !self.dirty[ci] && v.allowed && v.kind != KIND_SPLIT {
-            false
+        let exact_before = self.dirty_list.is_empty();
+        let r = if !self.dirty[ci] && v.allowed && v.kind != KIND_SPLIT {
+            v
         } else {
-            self.check(c).kind == KIND_SPLIT
+            self.check(c)
         };
+        let split = r.kind == KIND_SPLIT;
+        self.last_local = if exact_before && r.kind == KIND_LOCAL {
+            c
+        } else {
+            NONE
+        };
+        self.last_local_mask = r.mask;
         if self.forward {
             // Nothing will be undone: the log only serves the trees.
             self.log.clear();

@@ -33,6 +33,8 @@ pub struct WalkConfig {
     pub explorations: u32,
     /// Deepest an exploration goes.
     pub max_depth: usize,
+    /// Undo every kept action at the end (false for a forward-mode state, which cannot).
+    pub unwind: bool,
 }
 
 impl Default for WalkConfig {
@@ -40,6 +42,7 @@ impl Default for WalkConfig {
         WalkConfig {
             explorations: 2,
             max_depth: 10,
+            unwind: true,
         }
     }
 }
@@ -171,7 +174,8 @@ pub fn compare<S: Subject>(
 
 /// A random walk on `subject` and the oracle in lockstep: at each decision, a few explorations
 /// (random applies of allowed actions and undos, down to `max_depth`, then undo back), then one
-/// random allowed action kept; until no action is allowed; then every kept action undone.
+/// random allowed action kept; until no action is allowed; then every kept action undone
+/// (when `config.unwind`).
 /// Everything is compared after every apply and every undo.
 pub fn walk<S: Subject>(
     name: &str,
@@ -260,7 +264,7 @@ pub fn walk<S: Subject>(
     stats.left = (0..mesh.num_triangles() as u32)
         .filter(|&t| oracle.is_remaining(t))
         .count();
-    while !oracle.path().is_empty() {
+    while config.unwind && !oracle.path().is_empty() {
         let c = undo(
             subject,
             &mut oracle,
