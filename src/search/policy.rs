@@ -21,7 +21,7 @@ fn pick_with(x: u64, n: usize) -> usize {
 /// action `c`: SplitMix64's finaliser of `parent ^ (c + 1) * golden ratio`. Each node's draw
 /// depends on its path alone, not on what the search explored before it, so pruning and
 /// the order children are visited in cannot change any draw (or the decision).
-pub fn node_key(parent: u64, c: u32) -> u64 {
+fn node_key(parent: u64, c: u32) -> u64 {
     let mut z = parent ^ (u64::from(c) + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);

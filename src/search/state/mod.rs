@@ -233,7 +233,8 @@ pub struct State<'a> {
     pub searches: u64,
     /// Number of triangles those searches visited.
     pub searched: u64,
-    /// Split verdicts kept by [`State::shrink_split`] instead of a new search (statistics).
+    /// Split verdicts kept across an action inside one of their parts instead of a new
+    /// search (statistics).
     pub split_shrinks: u64,
 }
 
