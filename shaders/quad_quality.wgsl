@@ -50,7 +50,8 @@ const FRAC_PI_2: f32 = 1.57079632679490;
 override MODE: u32 = 0u;
 
 /// Invocations per workgroup (the host passes `gpu::KernelOptions::workgroup`). 256 was
-/// the fastest on an H100 (64: 12 % slower, 1024: 44 % slower, indexed layout).
+/// the fastest on an H100 (64: 11-12 % slower, 1024: 39-44 % slower, indexed layout, two
+/// runs of `bench gpu --shapes`).
 override WG: u32 = 256u;
 
 /// b - a with hi/lo compensation, scaled so that its largest component is 1 (0 stays 0).

@@ -56,10 +56,17 @@ struct Row {
     max_diff_f64: Option<f64>,
     /// Median device time of dispatches after a warm-up (seconds), where measured.
     warm_s: Option<f64>,
-    /// Bytes per candidate of this row's kernel (the bound's numerator).
-    bytes: Option<f64>,
-    /// The device's measured bandwidth (the bound's denominator), bytes per second.
-    bw: Option<f64>,
+    /// Device kernels: the time the kernel's bytes take at the measured bandwidth (seconds),
+    /// the bound the kernel time is compared with.
+    floor_s: Option<f64>,
+}
+
+/// Bytes per candidate a kernel of `layout` must move for `batch` (read + written).
+fn kernel_bytes(layout: Layout, batch: &Batch) -> f64 {
+    match layout {
+        Layout::Indexed => batch.bytes_per_candidate(),
+        Layout::Local => (LOCAL_QUAD_BYTES + 4) as f64,
+    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -173,14 +180,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         batch.push(&vertices, &quads)?;
         let prepare_s = t.elapsed().as_secs_f64();
         let c = batch.len();
-        let bytes = batch.bytes_per_candidate();
         println!(
             "\n{c} candidates ({n}x{n} jittered grid, {} vertices): host batch preparation \
-             (f64 -> hi/lo f32, index offsets) {:.2} ms; at least {bytes:.1} bytes per candidate \
+             (f64 -> hi/lo f32, index offsets) {:.2} ms; at least {:.1} bytes per candidate \
              indexed, {} with local edges",
             vertices.len(),
             prepare_s * 1e3,
-            LOCAL_QUAD_BYTES + 4
+            kernel_bytes(Layout::Indexed, &batch),
+            kernel_bytes(Layout::Local, &batch)
         );
         let reference: Vec<f64> = {
             use rayon::prelude::*;
@@ -212,8 +219,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 total_s: total,
                 max_diff_f64: Some(max_diff(&eta, &reference)),
                 warm_s: None,
-                bytes: None,
-                bw: None,
+                floor_s: None,
             })
         };
         if c <= args.serial_max {
@@ -235,8 +241,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 total_s: e,
                 max_diff_f64: Some(0.0),
                 warm_s: None,
-                bytes: None,
-                bw: None,
+                floor_s: None,
             });
             rows.push(cpu_row("cpu-twin, 1 thread".into(), &|| {
                 one.install(|| gpu::cpu::quad_quality(&batch))
@@ -249,10 +254,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         for (name, device, queue, kernels, bw) in &devices {
             for (k, what, is_eta, layout) in kernels {
                 let label = format!("{name} [{what}]");
-                let bytes = match layout {
-                    Layout::Indexed => bytes,
-                    Layout::Local => (LOCAL_QUAD_BYTES + 4) as f64,
-                };
                 k.run(device, queue, &batch)?; // warm-up
                 let (eta, t, total) = best_of(args.repeat, || {
                     let s = Instant::now();
@@ -269,8 +270,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     total_s: total,
                     max_diff_f64: is_eta.then(|| max_diff(&eta, &reference)),
                     warm_s: warm,
-                    bytes: Some(bytes),
-                    bw: Some(*bw),
+                    floor_s: Some(c as f64 * kernel_bytes(*layout, &batch) / bw),
                 });
             }
         }
@@ -310,10 +310,7 @@ fn print_rows(rows: &[Row]) {
         let k = r.t.kernel_best_s();
         // Throughput and bound from the warm time where there is one.
         let kt = r.warm_s.unwrap_or(k);
-        let bound = r
-            .bytes
-            .zip(r.bw)
-            .map(|(b, bw)| 100.0 * r.candidates as f64 * b / kt / bw);
+        let bound = r.floor_s.map(|f| 100.0 * f / kt);
         println!(
             "| {} | {} | {:.3} | {:.3} | {} | {:.3} | {:.3} | {:.1} | {:.1} | {} | {} |",
             r.backend,
@@ -353,10 +350,7 @@ fn shapes(
     println!("|---|---:|---:|---:|---:|");
     let max_wg = device.limits().max_compute_invocations_per_workgroup;
     for layout in [Layout::Indexed, Layout::Local] {
-        let bytes = match layout {
-            Layout::Indexed => batch.bytes_per_candidate(),
-            Layout::Local => (LOCAL_QUAD_BYTES + 4) as f64,
-        };
+        let floor_s = c * kernel_bytes(layout, batch) / bw;
         for memory_only in [false, true] {
             for workgroup in [64, 256, 1024].into_iter().filter(|&w| w <= max_wg) {
                 let options = KernelOptions {
@@ -367,7 +361,9 @@ fn shapes(
                 let k = Kernel::with_options(device, options)?;
                 k.run(device, queue, batch)?;
                 let Some(times) = k.dispatch_times(device, queue, dispatches, warm_up)? else {
-                    println!("| {options} | no timestamps | | | |");
+                    println!(
+                        "| {options} | no warm time (no timestamps, or several dispatches) | | | |"
+                    );
                     continue;
                 };
                 let best = times.iter().copied().fold(f64::INFINITY, f64::min);
@@ -377,7 +373,7 @@ fn shapes(
                     med * 1e3,
                     best * 1e3,
                     c / med / 1e9,
-                    100.0 * c * bytes / med / bw
+                    100.0 * floor_s / med
                 );
             }
         }
