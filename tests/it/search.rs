@@ -473,3 +473,35 @@ fn recombine_cli_prints_json_and_writes_meshes() {
         assert_eq!(bad.status.code(), Some(2), "{args:?}");
     }
 }
+
+/// `bench memory` prints one row per working-set size (1, 2, 4 MiB up to `--max-mib`) with
+/// positive latencies, and refuses sizes or load counts of zero.
+#[test]
+fn bench_memory_prints_one_row_per_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = crate::util::run_in(
+        dir.path(),
+        &["bench", "memory", "--max-mib", "4", "--loads", "20000"],
+    );
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{s}");
+    let rows: Vec<Vec<f64>> = s
+        .lines()
+        .filter_map(|l| {
+            let v: Vec<f64> = l
+                .split_whitespace()
+                .filter_map(|w| w.parse().ok())
+                .collect();
+            (v.len() == 4).then_some(v)
+        })
+        .collect();
+    let sizes: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+    assert_eq!(sizes, [1.0, 2.0, 4.0], "{s}");
+    for r in &rows {
+        assert!(r[1] > 0.0 && r[2] > 0.0 && r[3] > 0.0, "{s}");
+    }
+    for bad in [["--max-mib", "0"], ["--loads", "0"]] {
+        let out = crate::util::run_in(dir.path(), &["bench", "memory", bad[0], bad[1]]);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+    }
+}

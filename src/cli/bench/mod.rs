@@ -2,6 +2,7 @@
 
 mod gpu;
 mod io;
+mod memory;
 mod optimum;
 mod search;
 
@@ -23,6 +24,8 @@ enum What {
     Optimum(optimum::Args),
     /// Quad-quality evaluation: CPU, lavapipe, GPU.
     Gpu(gpu::Args),
+    /// This machine's random-access latency by working-set size (what large meshes cost).
+    Memory(memory::Args),
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -31,5 +34,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         What::Search(a) => search::run(a),
         What::Optimum(a) => optimum::run(a),
         What::Gpu(a) => gpu::run(a),
+        What::Memory(a) => memory::run(a),
     }
 }
