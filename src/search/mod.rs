@@ -203,6 +203,13 @@ impl<'a> Searcher<'a> {
         &self.state
     }
 
+    /// Work counters of the criterion since this searcher was built: the checks that needed
+    /// a search, and the triangles those searches visited (summed over runs; take
+    /// differences around a run). Deterministic for a given run, unlike its time.
+    pub fn criterion_work(&self) -> (u64, u64) {
+        (self.state.searches, self.state.searched)
+    }
+
     /// Runs `algo` with `seed` from the initial mesh. The same seed gives the same run on
     /// every platform (ChaCha8).
     pub fn run(&mut self, algo: Algo, seed: u64) -> RunOutcome {

@@ -303,10 +303,21 @@ fn runs_are_reproducible_and_searchers_reusable() {
         Algo::Selective { horizon: 1 },
         Algo::Selective { horizon: 4 },
     ] {
+        let w0 = s.criterion_work();
         let a = s.run(algo, SEED);
+        let w1 = s.criterion_work();
         let b = s.run(algo, SEED);
+        let w2 = s.criterion_work();
         let c = search::run(&mesh, &table, algo, SEED);
         assert_eq!(a.chosen, b.chosen, "{algo}");
+        // The work counters are as reproducible as the run (the benchmarks report them).
+        let work = |x: (u64, u64), y: (u64, u64)| (y.0 - x.0, y.1 - x.1);
+        assert_eq!(work(w0, w1), work(w1, w2), "{algo}");
+        if algo == Algo::GreedyNocrit {
+            assert_eq!(work(w0, w1), (0, 0), "no criterion, no search");
+        } else {
+            assert!(work(w0, w1).0 > 0 && work(w0, w1).1 > 0, "{algo}");
+        }
         assert_eq!(a.chosen, c.chosen, "{algo}");
         assert_eq!(a.quads + a.triangles_left / 2, mesh.num_triangles() / 2);
         let q: f64 = a.chosen.iter().map(|&c| table.eta[c as usize]).sum();

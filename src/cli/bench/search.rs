@@ -49,6 +49,10 @@ struct Row {
     quality_pct: Option<f64>,
     recombined_pct: f64,
     nodes_per_decision: f64,
+    /// Median per run of tree nodes expanded, per triangle of the mesh.
+    nodes_per_triangle: f64,
+    /// Median per run of the triangles the criterion's searches visited, per triangle.
+    searched_per_triangle: f64,
 }
 
 /// Runs `algo` with seeds `0..runs` and summarises the medians.
@@ -61,9 +65,13 @@ fn measure(
     runs: u64,
 ) -> Row {
     let (mut wall, mut cpu, mut q, mut rec, mut bf) = (vec![], vec![], vec![], vec![], vec![]);
+    let (mut nodes, mut searched) = (vec![], vec![]);
     for seed in 0..runs {
         let c0 = thread_cpu_s();
+        let w0 = searcher.criterion_work().1;
         let out = searcher.run(algo, seed);
+        searched.push((searcher.criterion_work().1 - w0) as f64 / triangles as f64);
+        nodes.push(out.nodes_expanded as f64 / triangles as f64);
         if let (Some(a), Some(b)) = (c0, thread_cpu_s()) {
             cpu.push((b - a) * 1e3);
         }
@@ -85,6 +93,8 @@ fn measure(
         quality_pct: opt.map(|o| 100.0 * median(q) / o),
         recombined_pct: median(rec),
         nodes_per_decision: median(bf),
+        nodes_per_triangle: median(nodes),
+        searched_per_triangle: median(searched),
     }
 }
 
@@ -162,12 +172,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     println!(
         "\nSelective h=3 on generated jittered grids (one surface, no hole), {GRID_ROUNDS} rounds \
          alternating the sizes (this VM's speed drifts from minute to minute): ns per triangle \
-         of the search, median over the seeds of a round, best and worst round:\n"
+         of the search, median over the seeds of a round, best and worst round; and the work, \
+         which does not depend on the machine: tree nodes expanded and triangles visited by the \
+         criterion's searches, per triangle (medians over the seeds):\n"
     );
     println!(
-        "| triangles | runs per round | ns per triangle (best round) | worst round | recombined % |"
+        "| triangles | runs per round | ns per triangle (best round) | worst round | recombined % \
+         | nodes per triangle | searched per triangle |"
     );
-    println!("|---:|---:|---:|---:|---:|");
+    println!("|---:|---:|---:|---:|---:|---:|---:|");
     // As `generate grid` then `mesh::load` would give them: in spatial order.
     let mut grids = Vec::new();
     let mut n = 10_000;
@@ -200,6 +213,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let mut per = vec![Vec::new(); grids.len()];
     let mut recombined = vec![0.0; grids.len()];
+    let mut work = vec![(0.0, 0.0); grids.len()];
     for _ in 0..GRID_ROUNDS {
         for (i, ((g, _), s)) in grids.iter().zip(&mut searchers).enumerate() {
             let nt = g.num_triangles();
@@ -213,6 +227,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             );
             per[i].push(r.wall_ms * 1e6 / nt as f64);
             recombined[i] = r.recombined_pct;
+            work[i] = (r.nodes_per_triangle, r.searched_per_triangle);
         }
     }
     for (i, (g, _)) in grids.iter().enumerate() {
@@ -220,9 +235,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let best = per[i].iter().copied().fold(f64::INFINITY, f64::min);
         let worst = per[i].iter().copied().fold(0.0, f64::max);
         println!(
-            "| {nt} | {} | {best:.0} | {worst:.0} | {:.2} |",
+            "| {nt} | {} | {best:.0} | {worst:.0} | {:.2} | {:.3} | {:.2} |",
             runs_for(nt),
-            recombined[i]
+            recombined[i],
+            work[i].0,
+            work[i].1
         );
     }
     Ok(ExitCode::SUCCESS)
