@@ -289,7 +289,9 @@ impl Searcher<'_> {
             let t = self.state.bucket_nth(k, i);
             if k == 1 {
                 // One allowed action: no tree can change the decision, so none is built.
-                let c = table.by_triangle[t as usize]
+                let c = self
+                    .state
+                    .candidates_of(t)
                     .into_iter()
                     .find(|&c| c != NONE && self.state.is_allowed(c))
                     .expect("a triangle of P_1 has an allowed action");
@@ -303,7 +305,7 @@ impl Searcher<'_> {
             // Children in decreasing reward, so good leaves come first and bound the rest;
             // ties between the root's children still go to the first in `by_triangle`.
             let mut kids = [(-1.0, 0, NONE); 3];
-            for (slot, c) in table.by_triangle[t as usize].into_iter().enumerate() {
+            for (slot, c) in self.state.candidates_of(t).into_iter().enumerate() {
                 if c != NONE && self.state.is_allowed(c) {
                     kids[slot] = (table.eta[c as usize], slot, c);
                 }
@@ -359,7 +361,7 @@ impl Searcher<'_> {
         };
         self.nodes += 1;
         let mut kids = [(-1.0, NONE); 3];
-        for (i, c) in table.by_triangle[t as usize].into_iter().enumerate() {
+        for (i, c) in self.state.candidates_of(t).into_iter().enumerate() {
             if allowed & (1 << i) != 0 {
                 kids[i] = (table.eta[c as usize], c);
             }

@@ -27,7 +27,8 @@ const LOCAL_OK: [bool; 256] = {
 };
 
 use super::{
-    BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT, Op, State, Verdict,
+    BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT, Op, State,
+    TriLocal, Verdict,
 };
 use crate::mesh::NONE;
 
@@ -69,9 +70,9 @@ impl State<'_> {
     /// [`State::check`] when the local proof does not settle it (or the quad has a
     /// neighbour across two of its sides); `mask`: the clean quad vertices.
     pub(super) fn check_slow(&mut self, c: u32, mask: u8) -> Verdict {
-        let [t0, t1] = self.table.pairs[c as usize];
-        let n = self.cand_nb[c as usize];
-        let q = self.table.quads[c as usize];
+        let [t0, t1] = self.cand_local[c as usize].pair;
+        let n = self.cand_local[c as usize].nb;
+        let q = self.cand_local[c as usize].quad;
         // Group label of each neighbour slot, kept flat: joining relabels the 4 slots.
         let mut root = [0u8, 1, 2, 3];
         #[inline(always)]
@@ -180,7 +181,6 @@ impl State<'_> {
         for s in 0..ns {
             self.nseed[s] = self.queue[s].len();
         }
-        let nb = &self.mesh.topology.neighbours[..];
         loop {
             // The verdict can only change when a search runs dry or two groups meet.
             let mut event = false;
@@ -189,7 +189,7 @@ impl State<'_> {
                     s,
                     ns,
                     base,
-                    nb,
+                    &self.tri,
                     &mut self.queue[s],
                     &mut self.head[s],
                     &mut self.stamp,
@@ -311,7 +311,7 @@ impl State<'_> {
     #[inline]
     pub(super) fn still_holds(&self, c: u32, v: &Verdict, arena: &[u32]) -> Option<bool> {
         if v.mask != 0 {
-            let q = self.table.quads[c as usize];
+            let q = self.cand_local[c as usize].quad;
             for i in 0..4 {
                 if v.mask & (1 << i) != 0 && self.dead_count[q[i] as usize] != 0 {
                     return None;
@@ -334,7 +334,7 @@ impl State<'_> {
         if v.kind == KIND_MET {
             return Some(true);
         }
-        let t0 = self.table.pairs[c as usize][0];
+        let t0 = self.cand_local[c as usize].pair[0];
         let total = self.polder_size[self.polder[t0 as usize] as usize] - 2;
         let rest = total.wrapping_sub(v.fin_known);
         Some(v.fin_odd as u32 + (rest & 1) <= 1)
@@ -440,7 +440,7 @@ fn search_step(
     s: usize,
     ns: usize,
     base: u32,
-    nb: &[[u32; 3]],
+    tri: &[TriLocal],
     queue: &mut Vec<u32>,
     head: &mut usize,
     stamp: &mut [u32],
@@ -453,7 +453,7 @@ fn search_step(
     *head = h + 1;
     let own = base | s as u32;
     let mut event = false;
-    for &u in &nb[x as usize] {
+    for &u in &tri[x as usize].nb {
         // `get_mut` answers None for NONE (out of range): no separate test.
         let Some(m) = stamp.get_mut(u as usize) else {
             continue;

@@ -64,11 +64,28 @@ struct CandLocal {
     /// The quad's vertices and the neighbours across its sides (NONE where none).
     quad: [u32; 4],
     nb: [u32; 4],
+    /// The candidate's two triangles (as in the table; kept here, on the same cache line
+    /// as the rest, because nearly every access to a candidate reads them).
+    pair: [u32; 2],
+    /// Its current verdict (base state).
+    verdict: Verdict,
     /// Bit i: quad vertex i has a closed fan.
     flags: u8,
     /// One triangle neighbours the quad across two of its sides (no local proof then).
     shared: bool,
 }
+/// Per triangle, in one record: what the searches, `apply` and the trees read about it.
+#[derive(Debug, Clone, Copy)]
+struct TriLocal {
+    /// Its vertices, then the vertex across each of its sides (NONE without a neighbour):
+    /// every vertex of every quad it can be part of.
+    ring: [u32; 6],
+    /// The triangle across each side (the dual graph), or NONE.
+    nb: [u32; 3],
+    /// The candidate across each side (the table's `by_triangle`), or NONE.
+    cands: [u32; 3],
+}
+
 /// Owner mark for the two triangles being removed during a search.
 const BLOCKED: u32 = 7;
 /// Search mark of a used triangle: above every epoch's marks, so one comparison tells an
@@ -155,12 +172,12 @@ pub struct State<'a> {
     mesh: &'a Mesh,
     table: &'a CandidateTable,
     // ---- static ----
-    /// Neighbours across the quad's edges `[s0-o1, o1-s1, s1-o0, o0-s0]`, or NONE.
-    cand_nb: Vec<[u32; 4]>,
     /// Vertex fan is one closed cycle of triangles in the dual graph.
     closed: Vec<bool>,
     /// Per candidate: what the local proof reads.
     cand_local: Vec<CandLocal>,
+    /// Per triangle: its ring of vertices, neighbours and candidates.
+    tri: Vec<TriLocal>,
     /// Candidates whose quad has vertex `v` (CSR).
     vc_start: Vec<u32>,
     vc_list: Vec<u32>,
@@ -169,7 +186,6 @@ pub struct State<'a> {
     remaining: u32,
     count: Vec<u8>,
     sets: OrderedSets,
-    verdict: Vec<Verdict>,
     /// Version of each base verdict, which the watch lists refer to (kept apart: read for
     /// every watch entry).
     cert_ver: Vec<u32>,
@@ -333,6 +349,8 @@ impl<'a> State<'a> {
                 let mut l = CandLocal {
                     quad,
                     nb,
+                    pair: table.pairs[c],
+                    verdict: Verdict::default(),
                     flags: 0,
                     shared: false,
                 };
@@ -345,7 +363,7 @@ impl<'a> State<'a> {
                 l
             })
             .collect();
-        let ring: Vec<[u32; 6]> = (0..nt)
+        let tri: Vec<TriLocal> = (0..nt)
             .map(|t| {
                 let tri = mesh.triangles[t];
                 let mut r = [tri[0], tri[1], tri[2], NONE, NONE, NONE];
@@ -359,22 +377,25 @@ impl<'a> State<'a> {
                             .unwrap_or(NONE);
                     }
                 }
-                r
+                TriLocal {
+                    ring: r,
+                    nb: nb[t],
+                    cands: table.by_triangle[t],
+                }
             })
             .collect();
         let mut st = State {
             mesh,
             table,
-            cand_nb,
             closed,
             cand_local,
+            tri,
             vc_start,
             vc_list,
             alive: vec![true; nt],
             remaining: nt as u32,
             count: vec![0; nt],
             sets: OrderedSets::new(nt),
-            verdict: vec![Verdict::default(); m],
             cert_ver: vec![0; m],
             base_cert: Vec::new(),
             base_cert_init: 0,
@@ -395,7 +416,7 @@ impl<'a> State<'a> {
             chosen: Vec::new(),
             quality: vec![0.0],
             log: Vec::new(),
-            tree: Overlay::new(m, nv, ring),
+            tree: Overlay::new(m, nv, nt),
             forward: false,
             initial: None,
             last_local: NONE,
@@ -453,7 +474,7 @@ impl<'a> State<'a> {
     /// allows it. Exact at any time.
     #[inline]
     pub fn is_allowed(&self, c: u32) -> bool {
-        self.verdict[c as usize].allowed
+        self.cand_local[c as usize].verdict.allowed
     }
 
     /// Number of allowed actions of triangle `t` (the `k` of `P_k`); 0 for a used triangle.
@@ -471,14 +492,35 @@ impl<'a> State<'a> {
     /// Both triangles of `c` remain (whatever the criterion says).
     #[inline]
     pub fn is_live(&self, c: u32) -> bool {
-        let [a, b] = self.table.pairs[c as usize];
+        let [a, b] = self.cand_local[c as usize].pair;
         self.alive[a as usize] && self.alive[b as usize]
+    }
+
+    /// The vertices of triangle `t` (as in the mesh).
+    #[inline]
+    fn verts(&self, t: u32) -> [u32; 3] {
+        let r = &self.tri[t as usize].ring;
+        [r[0], r[1], r[2]]
+    }
+
+    /// The candidate across each side of triangle `t` (the table's `by_triangle[t]`), read
+    /// from the state's per-triangle record.
+    #[inline]
+    pub fn candidates_of(&self, t: u32) -> [u32; 3] {
+        self.tri[t as usize].cands
+    }
+
+    /// The triangle of `c` other than `t`.
+    #[inline]
+    fn other(&self, c: u32, t: u32) -> u32 {
+        let [a, b] = self.cand_local[c as usize].pair;
+        if a == t { b } else { a }
     }
 
     /// Every allowed action, in increasing candidate order (O(candidates); for tests).
     pub fn allowed_actions(&self) -> Vec<u32> {
         (0..self.table.len() as u32)
-            .filter(|&c| self.verdict[c as usize].allowed)
+            .filter(|&c| self.cand_local[c as usize].verdict.allowed)
             .collect()
     }
 
@@ -542,7 +584,7 @@ impl<'a> State<'a> {
     /// The neighbours across the quad edges of candidate `c`, `NONE` where there is none.
     #[inline]
     pub fn quad_neighbours(&self, c: u32) -> [u32; 4] {
-        self.cand_nb[c as usize]
+        self.cand_local[c as usize].nb
     }
 
     /// Number of applied actions that `undo` can revert.
@@ -557,7 +599,7 @@ impl<'a> State<'a> {
         }
         let mut r = self.check(c);
         let ci = c as usize;
-        let old = self.verdict[ci];
+        let old = self.cand_local[ci].verdict;
         // A verdict of the local kind is never read back through its mask (the trees
         // recompute the local proof first), so a new mask alone is not a change.
         if r.kind == KIND_LOCAL && old.kind == KIND_LOCAL && r.allowed == old.allowed {
@@ -572,9 +614,9 @@ impl<'a> State<'a> {
         let ver = self.ver;
         self.cert_ver[ci] = ver;
         (r.cert, r.cert_len) = self.append_cert(r.kind, false);
-        self.verdict[ci] = r;
+        self.cand_local[ci].verdict = r;
         if r.allowed != old.allowed {
-            let [t0, t1] = self.table.pairs[ci];
+            let [t0, t1] = self.cand_local[ci].pair;
             for t in [t0, t1] {
                 let k = self.count[t as usize];
                 self.set_count(t, if r.allowed { k + 1 } else { k - 1 });
@@ -627,15 +669,15 @@ impl<'a> State<'a> {
             return false;
         }
         let ci = c as usize;
-        let v = self.verdict[ci];
+        let v = self.cand_local[ci].verdict;
         if v.kind != KIND_SPLIT {
             return false;
         }
-        let (qc, qy) = (self.table.quads[ci], self.table.quads[y as usize]);
+        let (qc, qy) = (self.cand_local[ci].quad, self.cand_local[y as usize].quad);
         if qc.iter().any(|a| qy.contains(a)) {
             return false;
         }
-        let [a, b] = self.table.pairs[y as usize];
+        let [a, b] = self.cand_local[y as usize].pair;
         let (off, fin, len) = (v.cert as usize, v.fin_known as usize, v.cert_len as usize);
         let cert = &self.base_cert[off..off + len];
         let keep = |t: &u32| *t != a && *t != b;
@@ -680,7 +722,7 @@ impl<'a> State<'a> {
             }
             (new, self.base_cert.len() - new, v.fin_known)
         };
-        self.verdict[ci] = Verdict {
+        self.cand_local[ci].verdict = Verdict {
             cert: off as u32,
             cert_len: len as u32,
             fin_known,
@@ -695,22 +737,23 @@ impl<'a> State<'a> {
     /// close within 64 steps.
     fn fans(&mut self, y: u32, mask: u8) -> bool {
         self.fan.clear();
-        let [a, b] = self.table.pairs[y as usize];
-        let q = self.table.quads[y as usize];
-        let nb = &self.mesh.topology.neighbours;
-        let tris = &self.mesh.triangles;
+        let [a, b] = self.cand_local[y as usize].pair;
+        let q = self.cand_local[y as usize].quad;
         for (i, &v) in q.iter().enumerate() {
             if mask & (1 << i) == 0 {
                 continue;
             }
-            let start = if tris[a as usize].contains(&v) { a } else { b };
+            let start = if self.verts(a).contains(&v) { a } else { b };
             // Walk around v: leave each triangle across its other edge at v.
             let (mut t, mut prev) = (start, NONE);
             for _ in 0..64 {
-                let tri = tris[t as usize];
-                let k = tri.iter().position(|&x| x == v).expect("v is a corner");
+                let r = &self.tri[t as usize];
+                let k = r.ring[..3]
+                    .iter()
+                    .position(|&x| x == v)
+                    .expect("v is a corner");
                 // Edges at v: (tri[k], tri[k+1]) is side k, (tri[k-1], tri[k]) side k-1.
-                let (s1, s2) = (nb[t as usize][k], nb[t as usize][(k + 2) % 3]);
+                let (s1, s2) = (r.nb[k], r.nb[(k + 2) % 3]);
                 let next = if s1 != prev { s1 } else { s2 };
                 if next == NONE {
                     return false;
@@ -788,10 +831,10 @@ impl<'a> State<'a> {
         let ci = c as usize;
         self.base_log(Op::Verdict {
             c,
-            old: self.verdict[ci],
+            old: self.cand_local[ci].verdict,
             ver: self.cert_ver[ci],
         });
-        self.verdict[ci].allowed = false;
+        self.cand_local[ci].verdict.allowed = false;
     }
 
     /// Marks the verdict of `c` as possibly stale (logged).
@@ -840,14 +883,14 @@ impl<'a> State<'a> {
     #[inline]
     pub fn is_allowed_lazy(&mut self, c: u32) -> bool {
         self.resolve(c);
-        self.verdict[c as usize].allowed
+        self.cand_local[c as usize].verdict.allowed
     }
 
     /// Exact number of allowed actions of `t` inside a lazy tree.
     #[inline]
     pub fn allowed_count_lazy(&mut self, t: u32) -> u32 {
         if self.alive[t as usize] {
-            for c in self.table.by_triangle[t as usize] {
+            for c in self.tri[t as usize].cands {
                 if c != NONE {
                     self.resolve(c);
                 }
@@ -870,14 +913,14 @@ impl<'a> State<'a> {
     /// the lazy queries (and `resolve_all`) recheck them when asked. For the trees.
     pub fn apply_lazy(&mut self, c: u32) {
         let ci = c as usize;
-        let [t0, t1] = self.table.pairs[ci];
+        let [t0, t1] = self.cand_local[ci].pair;
         assert!(
             self.is_live(c),
             "apply({c}): a triangle of the pair is already used"
         );
         // An exact verdict that found one part needs no new search; a split does (its
         // parts are relabelled).
-        let v = self.verdict[ci];
+        let v = self.cand_local[ci].verdict;
         let exact_before = self.dirty_list.is_empty();
         let r = if !self.dirty[ci] && v.allowed && v.kind != KIND_SPLIT {
             v
@@ -917,10 +960,10 @@ impl<'a> State<'a> {
         self.quality.push(total);
         for x in [t0, t1] {
             self.set_count(x, 0);
-            for c2 in self.table.by_triangle[x as usize] {
-                if c2 != NONE && self.verdict[c2 as usize].allowed {
+            for c2 in self.tri[x as usize].cands {
+                if c2 != NONE && self.cand_local[c2 as usize].verdict.allowed {
                     self.set_verdict_dead(c2);
-                    let u = self.table.other(c2, x);
+                    let u = self.other(c2, x);
                     if self.alive[u as usize] {
                         let k = self.count[u as usize];
                         self.set_count(u, k - 1);
@@ -931,7 +974,7 @@ impl<'a> State<'a> {
         // Vertices whose fan lost its first triangle: their links are gone.
         self.moved.clear();
         for x in [t0, t1] {
-            for v in self.mesh.triangles[x as usize] {
+            for v in self.verts(x) {
                 let vi = v as usize;
                 if self.dead_count[vi] == 0 && self.closed[vi] {
                     self.moved.push(v);
@@ -940,7 +983,7 @@ impl<'a> State<'a> {
             }
         }
         // The quad joins the dead components at its four vertices.
-        let qv = self.table.quads[ci];
+        let qv = self.cand_local[ci].quad;
         for i in 1..4 {
             if let Some(child) = self.union(qv[0], qv[i]) {
                 for j in 0..self.root_watch[child as usize].len() {
@@ -974,7 +1017,7 @@ impl<'a> State<'a> {
             for i in 0..self.split.len() {
                 let c2 = self.split[i];
                 if self.is_live(c2) {
-                    let pc = self.polder[self.table.pairs[c2 as usize][0] as usize];
+                    let pc = self.polder[self.cand_local[c2 as usize].pair[0] as usize];
                     if self.changed.contains(&pc) {
                         self.mark(c2);
                     }
@@ -994,11 +1037,11 @@ impl<'a> State<'a> {
             }
             match op {
                 Op::Apply(c) => {
-                    let [t0, t1] = self.table.pairs[c as usize];
+                    let [t0, t1] = self.cand_local[c as usize].pair;
                     for x in [t0, t1] {
                         self.alive[x as usize] = true;
                         self.stamp[x as usize] = 0;
-                        for v in self.mesh.triangles[x as usize] {
+                        for v in self.verts(x) {
                             self.dead_count[v as usize] -= 1;
                         }
                     }
@@ -1008,7 +1051,7 @@ impl<'a> State<'a> {
                     return;
                 }
                 Op::Verdict { c, old, ver } => {
-                    self.verdict[c as usize] = old;
+                    self.cand_local[c as usize].verdict = old;
                     self.cert_ver[c as usize] = ver;
                 }
                 Op::Count { t, old } => {
@@ -1074,7 +1117,7 @@ impl<'a> State<'a> {
         assert!(self.chosen.is_empty(), "set_forward with actions applied");
         if on && self.initial.is_none() {
             self.initial = Some(Box::new(Initial {
-                verdict: self.verdict.clone(),
+                verdict: self.cand_local.iter().map(|l| l.verdict).collect(),
                 cert_ver: self.cert_ver.clone(),
                 count: self.count.clone(),
                 sets: self.sets.clone(),
@@ -1099,7 +1142,9 @@ impl<'a> State<'a> {
             .initial
             .as_ref()
             .expect("forward mode keeps the initial state");
-        self.verdict.copy_from_slice(&init.verdict);
+        for (l, v) in self.cand_local.iter_mut().zip(&init.verdict) {
+            l.verdict = *v;
+        }
         self.cert_ver.copy_from_slice(&init.cert_ver);
         self.count.copy_from_slice(&init.count);
         self.sets.clone_from(&init.sets);
@@ -1161,7 +1206,7 @@ impl<'a> State<'a> {
             let expect = if self.alive[t] {
                 self.table.by_triangle[t]
                     .iter()
-                    .filter(|&&c| c != NONE && self.verdict[c as usize].allowed)
+                    .filter(|&&c| c != NONE && self.cand_local[c as usize].verdict.allowed)
                     .count() as u8
             } else {
                 0
@@ -1181,10 +1226,10 @@ impl<'a> State<'a> {
         }
         let naive = naive_allowed(self.mesh, self.table, &self.alive);
         for (c, &ok) in naive.iter().enumerate() {
-            if ok != self.verdict[c].allowed {
+            if ok != self.cand_local[c].verdict.allowed {
                 return Err(format!(
                     "candidate {c}: allowed {} but the naive criterion says {ok}",
-                    self.verdict[c].allowed
+                    self.cand_local[c].verdict.allowed
                 ));
             }
         }

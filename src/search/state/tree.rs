@@ -66,9 +66,6 @@ pub(super) struct Overlay {
     /// triangle around it (restored on pop from `touched_log`).
     touched_at: Vec<u32>,
     touched_log: Vec<u32>,
-    /// Per triangle: its vertices and the vertex opposite each of its sides (NONE without
-    /// a neighbour), i.e. every vertex of every quad it can be part of.
-    ring: Vec<[u32; 6]>,
     /// Certificates of the tree's verdicts (cleared at each `tree_begin`).
     pub(super) cert: Vec<u32>,
     /// Actions pushed, and the serial number of the node at each depth (0: the root).
@@ -92,15 +89,13 @@ pub(super) struct Overlay {
 }
 
 impl Overlay {
-    pub(super) fn new(m: usize, nv: usize, ring: Vec<[u32; 6]>) -> Overlay {
-        let nt = ring.len();
+    pub(super) fn new(m: usize, nv: usize, nt: usize) -> Overlay {
         Overlay {
             slots: Vec::new(),
             slots_end: vec![0],
             slots_serial: Vec::new(),
             touched_at: vec![0; nv],
             touched_log: Vec::new(),
-            ring,
             cached: vec![Cached::default(); m],
             shadowed: Vec::new(),
             cert: Vec::new(),
@@ -168,8 +163,8 @@ impl State<'_> {
     pub fn tree_allowed_mask(&mut self, t: u32) -> u8 {
         if self.tree.is_empty() {
             let mut bits = 0;
-            for (i, c) in self.table.by_triangle[t as usize].into_iter().enumerate() {
-                if c != NONE && self.verdict[c as usize].allowed {
+            for (i, c) in self.tri[t as usize].cands.into_iter().enumerate() {
+                if c != NONE && self.cand_local[c as usize].verdict.allowed {
                     bits |= 1 << i;
                 }
             }
@@ -215,7 +210,8 @@ impl State<'_> {
                     continue;
                 }
                 let keep = slot.local
-                    && tr.ring[t as usize]
+                    && self.tri[t as usize]
+                        .ring
                         .iter()
                         .all(|&v| v == NONE || tr.touched_at[v as usize] != here);
                 let slot = if keep { slot } else { self.count_local(t) };
@@ -230,7 +226,7 @@ impl State<'_> {
         };
         let start = self.tree.slots_end[d - 1];
         for i in from..d {
-            for t in self.cand_nb[self.tree.path[i] as usize] {
+            for t in self.cand_local[self.tree.path[i] as usize].nb {
                 if t != NONE && self.alive[t as usize] {
                     let slot = self.count_local(t);
                     self.tree.slots.push(slot);
@@ -255,8 +251,8 @@ impl State<'_> {
         if !self.alive[t as usize] {
             return slot;
         }
-        for (i, c) in self.table.by_triangle[t as usize].into_iter().enumerate() {
-            if c == NONE || !self.alive[self.table.other(c, t) as usize] {
+        for (i, c) in self.tri[t as usize].cands.into_iter().enumerate() {
+            if c == NONE || !self.alive[self.other(c, t) as usize] {
                 continue;
             }
             // The local proof inline; the rest of `tree_verdict` when it fails.
@@ -277,7 +273,7 @@ impl State<'_> {
     #[inline]
     fn tree_verdict(&mut self, c: u32) -> (bool, u8) {
         if self.tree.path.is_empty() {
-            let v = &self.verdict[c as usize];
+            let v = &self.cand_local[c as usize].verdict;
             return (v.allowed, v.kind);
         }
         // The local proof costs a few loads: cheaper than looking anything up. When it
@@ -305,7 +301,7 @@ impl State<'_> {
                 return (a, v.kind);
             }
         }
-        let v = self.verdict[ci];
+        let v = self.cand_local[ci].verdict;
         if v.kind != KIND_LOCAL {
             if let Some(a) = self.still_holds(c, &v, &self.base_cert) {
                 return (a, v.kind);
@@ -333,7 +329,7 @@ impl State<'_> {
             "tree_push({c}): a triangle of the pair is already used"
         );
         let ci = c as usize;
-        let [t0, t1] = self.table.pairs[ci];
+        let [t0, t1] = self.cand_local[ci].pair;
         // Only a split changes more than the polder's size.
         let split = self.tree_verdict(c).1 == KIND_SPLIT;
         self.log.push(Op::TreeApply(c));
@@ -363,12 +359,12 @@ impl State<'_> {
         for x in [t0, t1] {
             self.alive[x as usize] = false;
             self.stamp[x as usize] = DEAD;
-            for v in self.mesh.triangles[x as usize] {
+            for v in self.verts(x) {
                 self.dead_count[v as usize] += 1;
             }
         }
         self.remaining -= 2;
-        let q = self.table.quads[ci];
+        let q = self.cand_local[ci].quad;
         for i in 1..4 {
             self.union(q[0], q[i]);
         }
@@ -398,7 +394,7 @@ impl State<'_> {
         let c = tr.path.pop().expect("a pushed action");
         let n = tr.changed_len.pop().expect("logged");
         tr.changed.truncate(n);
-        for v in self.table.quads[c as usize].into_iter().rev() {
+        for v in self.cand_local[c as usize].quad.into_iter().rev() {
             tr.touched_at[v as usize] = tr.touched_log.pop().expect("logged");
         }
         tr.serial.pop();
@@ -409,10 +405,10 @@ impl State<'_> {
             let Op::TreeApply(c) = op else {
                 unreachable!("a base change inside a look-ahead tree");
             };
-            for x in self.table.pairs[c as usize] {
+            for x in self.cand_local[c as usize].pair {
                 self.alive[x as usize] = true;
                 self.stamp[x as usize] = 0;
-                for v in self.mesh.triangles[x as usize] {
+                for v in self.verts(x) {
                     self.dead_count[v as usize] -= 1;
                 }
             }
@@ -500,22 +496,17 @@ impl State<'_> {
     /// removed triangle or a merged dead component, and the base split verdicts when a
     /// polder split on the path. Every other live candidate reads as at the root.
     pub fn tree_affected(&self, out: &mut Vec<u32>) {
-        let table = self.table;
         let tr = &self.tree;
         for &c in &tr.path {
-            for x in table.pairs[c as usize] {
-                out.extend(
-                    table.by_triangle[x as usize]
-                        .iter()
-                        .filter(|&&c2| c2 != NONE),
-                );
+            for x in self.cand_local[c as usize].pair {
+                out.extend(self.tri[x as usize].cands.iter().filter(|&&c2| c2 != NONE));
                 for &(c2, ver) in &self.watch[x as usize] {
                     if self.cert_ver[c2 as usize] == ver {
                         out.push(c2);
                     }
                 }
             }
-            for v in table.quads[c as usize] {
+            for v in self.cand_local[c as usize].quad {
                 let v = v as usize;
                 out.extend(&self.vc_list[self.vc_start[v] as usize..self.vc_start[v + 1] as usize]);
             }
@@ -533,7 +524,7 @@ impl State<'_> {
         // takes a split on the path (otherwise every polder lost an even number).
         if !tr.changed.is_empty() {
             for &c2 in &self.split {
-                let t0 = table.pairs[c2 as usize][0];
+                let t0 = self.cand_local[c2 as usize].pair[0];
                 if self.is_live(c2) && tr.changed.contains(&self.polder[t0 as usize]) {
                     out.push(c2);
                 }
@@ -556,7 +547,7 @@ impl State<'_> {
         }
         let epoch = tr.affected_epoch;
         for &c in &cands {
-            for t in self.table.pairs[c as usize] {
+            for t in self.cand_local[c as usize].pair {
                 if tr.affected_mark[t as usize] != epoch {
                     tr.affected_mark[t as usize] = epoch;
                     tr.affected.push(t);
