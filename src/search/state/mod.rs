@@ -58,8 +58,10 @@ const KIND_SPLIT: u8 = 2;
 /// The quad touches removed regions in several places, all in distinct dead components:
 /// one part. Depends on those components staying distinct.
 const KIND_DISTINCT: u8 = 3;
-/// What the local proof of a candidate reads, in one place.
+/// Per candidate, on one cache line (64 bytes, aligned): what the local proof reads, its
+/// pair, its verdict and the verdict's version, which are read together.
 #[derive(Debug, Clone, Copy)]
+#[repr(align(64))]
 struct CandLocal {
     /// The quad's vertices and the neighbours across its sides (NONE where none).
     quad: [u32; 4],
@@ -69,11 +71,16 @@ struct CandLocal {
     pair: [u32; 2],
     /// Its current verdict (base state).
     verdict: Verdict,
+    /// Version of the verdict, which the watch lists refer to (read for every watch entry,
+    /// which then reads the pair).
+    cert_ver: u32,
     /// Bit i: quad vertex i has a closed fan.
     flags: u8,
     /// One triangle neighbours the quad across two of its sides (no local proof then).
     shared: bool,
 }
+const _: () = assert!(std::mem::size_of::<CandLocal>() == 64);
+
 /// Per triangle, in one record: what the searches, `apply` and the trees read about it.
 #[derive(Debug, Clone, Copy)]
 struct TriLocal {
@@ -186,9 +193,6 @@ pub struct State<'a> {
     remaining: u32,
     count: Vec<u8>,
     sets: OrderedSets,
-    /// Version of each base verdict, which the watch lists refer to (kept apart: read for
-    /// every watch entry).
-    cert_ver: Vec<u32>,
     /// Certificates of the base verdicts (append-only; cut back to the initial verdicts'
     /// when the state is reset).
     base_cert: Vec<u32>,
@@ -351,6 +355,7 @@ impl<'a> State<'a> {
                     nb,
                     pair: table.pairs[c],
                     verdict: Verdict::default(),
+                    cert_ver: 0,
                     flags: 0,
                     shared: false,
                 };
@@ -396,7 +401,6 @@ impl<'a> State<'a> {
             remaining: nt as u32,
             count: vec![0; nt],
             sets: OrderedSets::new(nt),
-            cert_ver: vec![0; m],
             base_cert: Vec::new(),
             base_cert_init: 0,
             ver: 0,
@@ -608,11 +612,11 @@ impl<'a> State<'a> {
         self.base_log(Op::Verdict {
             c,
             old,
-            ver: self.cert_ver[ci],
+            ver: self.cand_local[ci].cert_ver,
         });
         self.ver = self.ver.wrapping_add(1);
         let ver = self.ver;
-        self.cert_ver[ci] = ver;
+        self.cand_local[ci].cert_ver = ver;
         (r.cert, r.cert_len) = self.append_cert(r.kind, false);
         self.cand_local[ci].verdict = r;
         if r.allowed != old.allowed {
@@ -714,7 +718,7 @@ impl<'a> State<'a> {
                     self.base_cert.push(t);
                 }
             }
-            let ver = self.cert_ver[ci];
+            let ver = self.cand_local[ci].cert_ver;
             for i in 0..self.fan.len() {
                 let t = self.fan[i];
                 self.base_cert.push(t);
@@ -790,11 +794,11 @@ impl<'a> State<'a> {
         let list = &mut self.watch[t as usize];
         if self.forward && list.len() >= 16 && list.len().is_power_of_two() {
             let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]) as usize;
-            let cert_ver = &self.cert_ver;
+            let cand = &self.cand_local;
             let mut w = keep;
             for r in keep..list.len() {
                 let (c2, v2) = list[r];
-                if cert_ver[c2 as usize] == v2 {
+                if cand[c2 as usize].cert_ver == v2 {
                     list[w] = (c2, v2);
                     w += 1;
                 }
@@ -832,7 +836,7 @@ impl<'a> State<'a> {
         self.base_log(Op::Verdict {
             c,
             old: self.cand_local[ci].verdict,
-            ver: self.cert_ver[ci],
+            ver: self.cand_local[ci].cert_ver,
         });
         self.cand_local[ci].verdict.allowed = false;
     }
@@ -988,7 +992,7 @@ impl<'a> State<'a> {
             if let Some(child) = self.union(qv[0], qv[i]) {
                 for j in 0..self.root_watch[child as usize].len() {
                     let (c2, ver) = self.root_watch[child as usize][j];
-                    if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
+                    if self.cand_local[c2 as usize].cert_ver == ver && self.is_live(c2) {
                         self.mark(c2);
                     }
                 }
@@ -1007,7 +1011,7 @@ impl<'a> State<'a> {
             // Marking touches no watch list: iterate the list taken out, then put it back.
             let list = std::mem::take(&mut self.watch[x as usize]);
             for &(c2, ver) in &list {
-                if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
+                if self.cand_local[c2 as usize].cert_ver == ver && self.is_live(c2) {
                     self.mark(c2);
                 }
             }
@@ -1052,7 +1056,7 @@ impl<'a> State<'a> {
                 }
                 Op::Verdict { c, old, ver } => {
                     self.cand_local[c as usize].verdict = old;
-                    self.cert_ver[c as usize] = ver;
+                    self.cand_local[c as usize].cert_ver = ver;
                 }
                 Op::Count { t, old } => {
                     let cur = self.count[t as usize];
@@ -1118,7 +1122,7 @@ impl<'a> State<'a> {
         if on && self.initial.is_none() {
             self.initial = Some(Box::new(Initial {
                 verdict: self.cand_local.iter().map(|l| l.verdict).collect(),
-                cert_ver: self.cert_ver.clone(),
+                cert_ver: self.cand_local.iter().map(|l| l.cert_ver).collect(),
                 count: self.count.clone(),
                 sets: self.sets.clone(),
                 polder: self.polder.clone(),
@@ -1142,10 +1146,15 @@ impl<'a> State<'a> {
             .initial
             .as_ref()
             .expect("forward mode keeps the initial state");
-        for (l, v) in self.cand_local.iter_mut().zip(&init.verdict) {
+        for ((l, v), &ver) in self
+            .cand_local
+            .iter_mut()
+            .zip(&init.verdict)
+            .zip(&init.cert_ver)
+        {
             l.verdict = *v;
+            l.cert_ver = ver;
         }
-        self.cert_ver.copy_from_slice(&init.cert_ver);
         self.count.copy_from_slice(&init.count);
         self.sets.clone_from(&init.sets);
         self.polder.copy_from_slice(&init.polder);

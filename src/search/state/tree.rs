@@ -501,7 +501,7 @@ impl State<'_> {
             for x in self.cand_local[c as usize].pair {
                 out.extend(self.tri[x as usize].cands.iter().filter(|&&c2| c2 != NONE));
                 for &(c2, ver) in &self.watch[x as usize] {
-                    if self.cert_ver[c2 as usize] == ver {
+                    if self.cand_local[c2 as usize].cert_ver == ver {
                         out.push(c2);
                     }
                 }
@@ -514,7 +514,7 @@ impl State<'_> {
         for op in &self.log[tr.log_start..] {
             if let Op::Union { child, .. } = *op {
                 for &(c2, ver) in &self.root_watch[child as usize] {
-                    if self.cert_ver[c2 as usize] == ver {
+                    if self.cand_local[c2 as usize].cert_ver == ver {
                         out.push(c2);
                     }
                 }
