@@ -27,8 +27,7 @@ const LOCAL_OK: [bool; 256] = {
 };
 
 use super::{
-    BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT, Op, State,
-    TriLocal, Verdict,
+    BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT, Op, State, Verdict,
 };
 use crate::mesh::NONE;
 
@@ -181,6 +180,9 @@ impl State<'_> {
         for s in 0..ns {
             self.nseed[s] = self.queue[s].len();
         }
+        // The dense dual graph, not the triangle records: a search streams through many
+        // triangles and reads only their neighbours (a quarter of the bytes).
+        let nb = &self.mesh.topology.neighbours[..];
         loop {
             // The verdict can only change when a search runs dry or two groups meet.
             let mut event = false;
@@ -189,7 +191,7 @@ impl State<'_> {
                     s,
                     ns,
                     base,
-                    &self.tri,
+                    nb,
                     &mut self.queue[s],
                     &mut self.head[s],
                     &mut self.stamp,
@@ -440,7 +442,7 @@ fn search_step(
     s: usize,
     ns: usize,
     base: u32,
-    tri: &[TriLocal],
+    nb: &[[u32; 3]],
     queue: &mut Vec<u32>,
     head: &mut usize,
     stamp: &mut [u32],
@@ -453,7 +455,7 @@ fn search_step(
     *head = h + 1;
     let own = base | s as u32;
     let mut event = false;
-    for &u in &tri[x as usize].nb {
+    for &u in &nb[x as usize] {
         // `get_mut` answers None for NONE (out of range): no separate test.
         let Some(m) = stamp.get_mut(u as usize) else {
             continue;

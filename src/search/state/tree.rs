@@ -164,7 +164,7 @@ impl State<'_> {
         if self.tree.is_empty() {
             let mut bits = 0;
             for (i, c) in self.tri[t as usize].cands.into_iter().enumerate() {
-                if c != NONE && self.cand_local[c as usize].verdict.allowed {
+                if c != NONE && self.is_allowed(c) {
                     bits |= 1 << i;
                 }
             }
