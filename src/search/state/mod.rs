@@ -183,10 +183,6 @@ pub struct State<'a> {
     closed: Vec<bool>,
     /// Per candidate: what the local proof reads.
     cand_local: Vec<CandLocal>,
-    /// Each base verdict's `allowed`, one bit per candidate (a copy of the records'): the
-    /// greedy and uniform policies scan candidates in eta order, and this stays in the
-    /// first-level cache where the candidate records do not.
-    allowed: Vec<u64>,
     /// Per triangle: its ring of vertices, neighbours and candidates.
     tri: Vec<TriLocal>,
     /// Candidates whose quad has vertex `v` (CSR).
@@ -398,7 +394,6 @@ impl<'a> State<'a> {
             table,
             closed,
             cand_local,
-            allowed: vec![0; m.div_ceil(64)],
             tri,
             vc_start,
             vc_list,
@@ -483,7 +478,7 @@ impl<'a> State<'a> {
     /// allows it. Exact at any time.
     #[inline]
     pub fn is_allowed(&self, c: u32) -> bool {
-        self.allowed[c as usize / 64] >> (c % 64) & 1 != 0
+        self.cand_local[c as usize].verdict.allowed
     }
 
     /// Number of allowed actions of triangle `t` (the `k` of `P_k`); 0 for a used triangle.
@@ -623,7 +618,7 @@ impl<'a> State<'a> {
         let ver = self.ver;
         self.cand_local[ci].cert_ver = ver;
         (r.cert, r.cert_len) = self.append_cert(r.kind, false);
-        self.set_verdict(c, r);
+        self.cand_local[ci].verdict = r;
         if r.allowed != old.allowed {
             let [t0, t1] = self.cand_local[ci].pair;
             for t in [t0, t1] {
@@ -737,7 +732,7 @@ impl<'a> State<'a> {
             fin_known,
             ..v
         };
-        self.set_verdict(c, kept);
+        self.cand_local[ci].verdict = kept;
         self.split_shrinks += 1;
         true
     }
@@ -837,19 +832,6 @@ impl<'a> State<'a> {
         self.count[t as usize] = new;
     }
 
-    /// Sets the base verdict of `c` (record and `allowed` bit).
-    #[inline]
-    fn set_verdict(&mut self, c: u32, v: Verdict) {
-        let ci = c as usize;
-        self.cand_local[ci].verdict = v;
-        let bit = 1u64 << (ci % 64);
-        if v.allowed {
-            self.allowed[ci / 64] |= bit;
-        } else {
-            self.allowed[ci / 64] &= !bit;
-        }
-    }
-
     fn set_verdict_dead(&mut self, c: u32) {
         let ci = c as usize;
         self.base_log(Op::Verdict {
@@ -857,9 +839,7 @@ impl<'a> State<'a> {
             old: self.cand_local[ci].verdict,
             ver: self.cand_local[ci].cert_ver,
         });
-        let mut v = self.cand_local[ci].verdict;
-        v.allowed = false;
-        self.set_verdict(c, v);
+        self.cand_local[ci].verdict.allowed = false;
     }
 
     /// Marks the verdict of `c` as possibly stale (logged).
@@ -1076,7 +1056,7 @@ impl<'a> State<'a> {
                     return;
                 }
                 Op::Verdict { c, old, ver } => {
-                    self.set_verdict(c, old);
+                    self.cand_local[c as usize].verdict = old;
                     self.cand_local[c as usize].cert_ver = ver;
                 }
                 Op::Count { t, old } => {
@@ -1167,11 +1147,9 @@ impl<'a> State<'a> {
             .initial
             .as_ref()
             .expect("forward mode keeps the initial state");
-        self.allowed.iter_mut().for_each(|w| *w = 0);
         for (c, (v, &ver)) in init.verdict.iter().zip(&init.cert_ver).enumerate() {
             self.cand_local[c].verdict = *v;
             self.cand_local[c].cert_ver = ver;
-            self.allowed[c / 64] |= u64::from(v.allowed) << (c % 64);
         }
         self.count.copy_from_slice(&init.count);
         self.sets.clone_from(&init.sets);
@@ -1250,13 +1228,6 @@ impl<'a> State<'a> {
             if members != expect {
                 return Err(format!("P_{k} holds {members:?}, counts say {expect:?}"));
             }
-        }
-        if let Some(c) = (0..self.cand_local.len() as u32)
-            .find(|&c| self.is_allowed(c) != self.cand_local[c as usize].verdict.allowed)
-        {
-            return Err(format!(
-                "candidate {c}: allowed bit differs from its verdict"
-            ));
         }
         let naive = naive_allowed(self.mesh, self.table, &self.alive);
         for (c, &ok) in naive.iter().enumerate() {
