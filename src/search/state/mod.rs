@@ -36,6 +36,11 @@
 //!   vertices still clean, its certificate intact: checked on reading, nothing is marked),
 //!   else recomputed. `P_min` inside the tree (rare) is the base sets corrected by the
 //!   triangles the path can have changed.
+//! * **Layout.** What is read together is stored together: one 64-byte record per candidate
+//!   (quad, neighbours, pair, verdict and its version) and one per triangle (its ring of
+//!   vertices, neighbours, candidates), so that touching an element costs one cache line;
+//!   the lockstep search, which streams through many triangles for their neighbours only,
+//!   reads the mesh's dense dual graph instead.
 
 #![allow(clippy::needless_range_loop)] // index loops over the 4 quad sides read best
 
