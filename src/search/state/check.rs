@@ -56,7 +56,7 @@ impl State<'_> {
     /// neighbour of the quad (one part: the action is allowed). A handful of loads.
     #[inline(always)]
     pub(super) fn clean_mask(&self, c: u32) -> u8 {
-        let l = &self.cand_local[c as usize];
+        let l = &self.cand[c as usize];
         let (dead, alive) = (&self.dead_count[..], &self.alive[..]);
         let clean = |i: usize| ((dead[l.quad[i] as usize] == 0) as u8) << i;
         // `get` answers false for NONE (out of range): no separate test.
@@ -69,9 +69,9 @@ impl State<'_> {
     /// [`State::check`] when the local proof does not settle it (or the quad has a
     /// neighbour across two of its sides); `mask`: the clean quad vertices.
     pub(super) fn check_slow(&mut self, c: u32, mask: u8) -> Verdict {
-        let [t0, t1] = self.cand_local[c as usize].pair;
-        let n = self.cand_local[c as usize].nb;
-        let q = self.cand_local[c as usize].quad;
+        let [t0, t1] = self.cand[c as usize].pair;
+        let n = self.cand[c as usize].nb;
+        let q = self.cand[c as usize].quad;
         // Group label of each neighbour slot, kept flat: joining relabels the 4 slots.
         let mut root = [0u8, 1, 2, 3];
         #[inline(always)]
@@ -313,7 +313,7 @@ impl State<'_> {
     #[inline]
     pub(super) fn still_holds(&self, c: u32, v: &Verdict, arena: &[u32]) -> Option<bool> {
         if v.mask != 0 {
-            let q = self.cand_local[c as usize].quad;
+            let q = self.cand[c as usize].quad;
             for i in 0..4 {
                 if v.mask & (1 << i) != 0 && self.dead_count[q[i] as usize] != 0 {
                     return None;
@@ -336,7 +336,7 @@ impl State<'_> {
         if v.kind == KIND_MET {
             return Some(true);
         }
-        let t0 = self.cand_local[c as usize].pair[0];
+        let t0 = self.cand[c as usize].pair[0];
         let total = self.polder_size[self.polder[t0 as usize] as usize] - 2;
         let rest = total.wrapping_sub(v.fin_known);
         Some(v.fin_odd as u32 + (rest & 1) <= 1)

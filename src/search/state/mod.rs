@@ -67,7 +67,7 @@ const KIND_DISTINCT: u8 = 3;
 /// pair, its verdict and the verdict's version, which are read together.
 #[derive(Debug, Clone, Copy)]
 #[repr(align(64))]
-struct CandLocal {
+struct CandRecord {
     /// The quad's vertices and the neighbours across its sides (NONE where none).
     quad: [u32; 4],
     nb: [u32; 4],
@@ -84,11 +84,11 @@ struct CandLocal {
     /// One triangle neighbours the quad across two of its sides (no local proof then).
     shared: bool,
 }
-const _: () = assert!(std::mem::size_of::<CandLocal>() == 64);
+const _: () = assert!(std::mem::size_of::<CandRecord>() == 64);
 
 /// Per triangle, in one record: what the searches, `apply` and the trees read about it.
 #[derive(Debug, Clone, Copy)]
-struct TriLocal {
+struct TriRecord {
     /// Its vertices, then the vertex across each of its sides (NONE without a neighbour):
     /// every vertex of every quad it can be part of.
     ring: [u32; 6],
@@ -186,10 +186,10 @@ pub struct State<'a> {
     // ---- static ----
     /// Vertex fan is one closed cycle of triangles in the dual graph.
     closed: Vec<bool>,
-    /// Per candidate: what the local proof reads.
-    cand_local: Vec<CandLocal>,
+    /// Per candidate: its quad, neighbours, pair, verdict and version (one cache line).
+    cand: Vec<CandRecord>,
     /// Per triangle: its ring of vertices, neighbours and candidates.
-    tri: Vec<TriLocal>,
+    tri: Vec<TriRecord>,
     /// Candidates whose quad has vertex `v` (CSR).
     vc_start: Vec<u32>,
     vc_list: Vec<u32>,
@@ -352,10 +352,10 @@ impl<'a> State<'a> {
                 fill[v as usize] += 1;
             }
         }
-        let cand_local: Vec<CandLocal> = (0..m)
+        let cand: Vec<CandRecord> = (0..m)
             .map(|c| {
                 let (quad, nb) = (table.quads[c], cand_nb[c]);
-                let mut l = CandLocal {
+                let mut l = CandRecord {
                     quad,
                     nb,
                     pair: table.pairs[c],
@@ -373,7 +373,7 @@ impl<'a> State<'a> {
                 l
             })
             .collect();
-        let tri: Vec<TriLocal> = (0..nt)
+        let tri: Vec<TriRecord> = (0..nt)
             .map(|t| {
                 let tri = mesh.triangles[t];
                 let mut r = [tri[0], tri[1], tri[2], NONE, NONE, NONE];
@@ -387,7 +387,7 @@ impl<'a> State<'a> {
                             .unwrap_or(NONE);
                     }
                 }
-                TriLocal {
+                TriRecord {
                     ring: r,
                     nb: nb[t],
                     cands: table.by_triangle[t],
@@ -398,7 +398,7 @@ impl<'a> State<'a> {
             mesh,
             table,
             closed,
-            cand_local,
+            cand,
             tri,
             vc_start,
             vc_list,
@@ -483,7 +483,7 @@ impl<'a> State<'a> {
     /// allows it. Exact at any time.
     #[inline]
     pub fn is_allowed(&self, c: u32) -> bool {
-        self.cand_local[c as usize].verdict.allowed
+        self.cand[c as usize].verdict.allowed
     }
 
     /// Number of allowed actions of triangle `t` (the `k` of `P_k`); 0 for a used triangle.
@@ -501,7 +501,7 @@ impl<'a> State<'a> {
     /// Both triangles of `c` remain (whatever the criterion says).
     #[inline]
     pub fn is_live(&self, c: u32) -> bool {
-        let [a, b] = self.cand_local[c as usize].pair;
+        let [a, b] = self.cand[c as usize].pair;
         self.alive[a as usize] && self.alive[b as usize]
     }
 
@@ -522,14 +522,14 @@ impl<'a> State<'a> {
     /// The triangle of `c` other than `t`.
     #[inline]
     fn other(&self, c: u32, t: u32) -> u32 {
-        let [a, b] = self.cand_local[c as usize].pair;
+        let [a, b] = self.cand[c as usize].pair;
         if a == t { b } else { a }
     }
 
     /// Every allowed action, in increasing candidate order (O(candidates); for tests).
     pub fn allowed_actions(&self) -> Vec<u32> {
         (0..self.table.len() as u32)
-            .filter(|&c| self.cand_local[c as usize].verdict.allowed)
+            .filter(|&c| self.cand[c as usize].verdict.allowed)
             .collect()
     }
 
@@ -593,7 +593,7 @@ impl<'a> State<'a> {
     /// The neighbours across the quad edges of candidate `c`, `NONE` where there is none.
     #[inline]
     pub fn quad_neighbours(&self, c: u32) -> [u32; 4] {
-        self.cand_local[c as usize].nb
+        self.cand[c as usize].nb
     }
 
     /// Number of applied actions that `undo` can revert.
@@ -608,7 +608,7 @@ impl<'a> State<'a> {
         }
         let mut r = self.check(c);
         let ci = c as usize;
-        let old = self.cand_local[ci].verdict;
+        let old = self.cand[ci].verdict;
         // A verdict of the local kind is never read back through its mask (the trees
         // recompute the local proof first), so a new mask alone is not a change.
         if r.kind == KIND_LOCAL && old.kind == KIND_LOCAL && r.allowed == old.allowed {
@@ -617,15 +617,15 @@ impl<'a> State<'a> {
         self.base_log(Op::Verdict {
             c,
             old,
-            ver: self.cand_local[ci].cert_ver,
+            ver: self.cand[ci].cert_ver,
         });
         self.ver = self.ver.wrapping_add(1);
         let ver = self.ver;
-        self.cand_local[ci].cert_ver = ver;
+        self.cand[ci].cert_ver = ver;
         (r.cert, r.cert_len) = self.append_cert(r.kind, false);
-        self.cand_local[ci].verdict = r;
+        self.cand[ci].verdict = r;
         if r.allowed != old.allowed {
-            let [t0, t1] = self.cand_local[ci].pair;
+            let [t0, t1] = self.cand[ci].pair;
             for t in [t0, t1] {
                 let k = self.count[t as usize];
                 self.set_count(t, if r.allowed { k + 1 } else { k - 1 });
@@ -678,15 +678,15 @@ impl<'a> State<'a> {
             return false;
         }
         let ci = c as usize;
-        let v = self.cand_local[ci].verdict;
+        let v = self.cand[ci].verdict;
         if v.kind != KIND_SPLIT {
             return false;
         }
-        let (qc, qy) = (self.cand_local[ci].quad, self.cand_local[y as usize].quad);
+        let (qc, qy) = (self.cand[ci].quad, self.cand[y as usize].quad);
         if qc.iter().any(|a| qy.contains(a)) {
             return false;
         }
-        let [a, b] = self.cand_local[y as usize].pair;
+        let [a, b] = self.cand[y as usize].pair;
         let (off, fin, len) = (v.cert as usize, v.fin_known as usize, v.cert_len as usize);
         let cert = &self.base_cert[off..off + len];
         let keep = |t: &u32| *t != a && *t != b;
@@ -723,7 +723,7 @@ impl<'a> State<'a> {
                     self.base_cert.push(t);
                 }
             }
-            let ver = self.cand_local[ci].cert_ver;
+            let ver = self.cand[ci].cert_ver;
             for i in 0..self.fan.len() {
                 let t = self.fan[i];
                 self.base_cert.push(t);
@@ -737,7 +737,7 @@ impl<'a> State<'a> {
             fin_known,
             ..v
         };
-        self.cand_local[ci].verdict = kept;
+        self.cand[ci].verdict = kept;
         self.split_shrinks += 1;
         true
     }
@@ -747,8 +747,8 @@ impl<'a> State<'a> {
     /// close within 64 steps.
     fn fans(&mut self, y: u32, mask: u8) -> bool {
         self.fan.clear();
-        let [a, b] = self.cand_local[y as usize].pair;
-        let q = self.cand_local[y as usize].quad;
+        let [a, b] = self.cand[y as usize].pair;
+        let q = self.cand[y as usize].quad;
         for (i, &v) in q.iter().enumerate() {
             if mask & (1 << i) == 0 {
                 continue;
@@ -800,7 +800,7 @@ impl<'a> State<'a> {
         let list = &mut self.watch[t as usize];
         if self.forward && list.len() >= 16 && list.len().is_power_of_two() {
             let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]) as usize;
-            let cand = &self.cand_local;
+            let cand = &self.cand;
             let mut w = keep;
             for r in keep..list.len() {
                 let (c2, v2) = list[r];
@@ -841,10 +841,10 @@ impl<'a> State<'a> {
         let ci = c as usize;
         self.base_log(Op::Verdict {
             c,
-            old: self.cand_local[ci].verdict,
-            ver: self.cand_local[ci].cert_ver,
+            old: self.cand[ci].verdict,
+            ver: self.cand[ci].cert_ver,
         });
-        self.cand_local[ci].verdict.allowed = false;
+        self.cand[ci].verdict.allowed = false;
     }
 
     /// Marks the verdict of `c` as possibly stale (logged).
@@ -923,14 +923,14 @@ impl<'a> State<'a> {
     /// the lazy queries (and `resolve_all`) recheck them when asked. For the trees.
     pub fn apply_lazy(&mut self, c: u32) {
         let ci = c as usize;
-        let [t0, t1] = self.cand_local[ci].pair;
+        let [t0, t1] = self.cand[ci].pair;
         assert!(
             self.is_live(c),
             "apply({c}): a triangle of the pair is already used"
         );
         // An exact verdict that found one part needs no new search; a split does (its
         // parts are relabelled).
-        let v = self.cand_local[ci].verdict;
+        let v = self.cand[ci].verdict;
         let exact_before = self.dirty_list.is_empty();
         let r = if !self.dirty[ci] && v.allowed && v.kind != KIND_SPLIT {
             v
@@ -971,7 +971,7 @@ impl<'a> State<'a> {
         for x in [t0, t1] {
             self.set_count(x, 0);
             for c2 in self.tri[x as usize].cands {
-                if c2 != NONE && self.cand_local[c2 as usize].verdict.allowed {
+                if c2 != NONE && self.cand[c2 as usize].verdict.allowed {
                     self.set_verdict_dead(c2);
                     let u = self.other(c2, x);
                     if self.alive[u as usize] {
@@ -993,12 +993,12 @@ impl<'a> State<'a> {
             }
         }
         // The quad joins the dead components at its four vertices.
-        let qv = self.cand_local[ci].quad;
+        let qv = self.cand[ci].quad;
         for i in 1..4 {
             if let Some(child) = self.union(qv[0], qv[i]) {
                 for j in 0..self.root_watch[child as usize].len() {
                     let (c2, ver) = self.root_watch[child as usize][j];
-                    if self.cand_local[c2 as usize].cert_ver == ver && self.is_live(c2) {
+                    if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
                         self.mark(c2);
                     }
                 }
@@ -1017,7 +1017,7 @@ impl<'a> State<'a> {
             // Marking touches no watch list: iterate the list taken out, then put it back.
             let list = std::mem::take(&mut self.watch[x as usize]);
             for &(c2, ver) in &list {
-                if self.cand_local[c2 as usize].cert_ver == ver && self.is_live(c2) {
+                if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
                     self.mark(c2);
                 }
             }
@@ -1027,7 +1027,7 @@ impl<'a> State<'a> {
             for i in 0..self.split.len() {
                 let c2 = self.split[i];
                 if self.is_live(c2) {
-                    let pc = self.polder[self.cand_local[c2 as usize].pair[0] as usize];
+                    let pc = self.polder[self.cand[c2 as usize].pair[0] as usize];
                     if self.changed.contains(&pc) {
                         self.mark(c2);
                     }
@@ -1047,7 +1047,7 @@ impl<'a> State<'a> {
             }
             match op {
                 Op::Apply(c) => {
-                    let [t0, t1] = self.cand_local[c as usize].pair;
+                    let [t0, t1] = self.cand[c as usize].pair;
                     for x in [t0, t1] {
                         self.alive[x as usize] = true;
                         self.stamp[x as usize] = 0;
@@ -1061,8 +1061,8 @@ impl<'a> State<'a> {
                     return;
                 }
                 Op::Verdict { c, old, ver } => {
-                    self.cand_local[c as usize].verdict = old;
-                    self.cand_local[c as usize].cert_ver = ver;
+                    self.cand[c as usize].verdict = old;
+                    self.cand[c as usize].cert_ver = ver;
                 }
                 Op::Count { t, old } => {
                     let cur = self.count[t as usize];
@@ -1127,8 +1127,8 @@ impl<'a> State<'a> {
         assert!(self.chosen.is_empty(), "set_forward with actions applied");
         if on && self.initial.is_none() {
             self.initial = Some(Box::new(Initial {
-                verdict: self.cand_local.iter().map(|l| l.verdict).collect(),
-                cert_ver: self.cand_local.iter().map(|l| l.cert_ver).collect(),
+                verdict: self.cand.iter().map(|l| l.verdict).collect(),
+                cert_ver: self.cand.iter().map(|l| l.cert_ver).collect(),
                 count: self.count.clone(),
                 sets: self.sets.clone(),
                 polder: self.polder.clone(),
@@ -1153,8 +1153,8 @@ impl<'a> State<'a> {
             .as_ref()
             .expect("forward mode keeps the initial state");
         for (c, (v, &ver)) in init.verdict.iter().zip(&init.cert_ver).enumerate() {
-            self.cand_local[c].verdict = *v;
-            self.cand_local[c].cert_ver = ver;
+            self.cand[c].verdict = *v;
+            self.cand[c].cert_ver = ver;
         }
         self.count.copy_from_slice(&init.count);
         self.sets.clone_from(&init.sets);
@@ -1216,7 +1216,7 @@ impl<'a> State<'a> {
             let expect = if self.alive[t] {
                 self.table.by_triangle[t]
                     .iter()
-                    .filter(|&&c| c != NONE && self.cand_local[c as usize].verdict.allowed)
+                    .filter(|&&c| c != NONE && self.cand[c as usize].verdict.allowed)
                     .count() as u8
             } else {
                 0
@@ -1236,10 +1236,10 @@ impl<'a> State<'a> {
         }
         let naive = naive_allowed(self.mesh, self.table, &self.alive);
         for (c, &ok) in naive.iter().enumerate() {
-            if ok != self.cand_local[c].verdict.allowed {
+            if ok != self.cand[c].verdict.allowed {
                 return Err(format!(
                     "candidate {c}: allowed {} but the naive criterion says {ok}",
-                    self.cand_local[c].verdict.allowed
+                    self.cand[c].verdict.allowed
                 ));
             }
         }

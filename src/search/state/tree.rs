@@ -226,7 +226,7 @@ impl State<'_> {
         };
         let start = self.tree.slots_end[d - 1];
         for i in from..d {
-            for t in self.cand_local[self.tree.path[i] as usize].nb {
+            for t in self.cand[self.tree.path[i] as usize].nb {
                 if t != NONE && self.alive[t as usize] {
                     let slot = self.count_local(t);
                     self.tree.slots.push(slot);
@@ -273,7 +273,7 @@ impl State<'_> {
     #[inline]
     fn tree_verdict(&mut self, c: u32) -> (bool, u8) {
         if self.tree.path.is_empty() {
-            let v = &self.cand_local[c as usize].verdict;
+            let v = &self.cand[c as usize].verdict;
             return (v.allowed, v.kind);
         }
         // The local proof costs a few loads: cheaper than looking anything up. When it
@@ -301,7 +301,7 @@ impl State<'_> {
                 return (a, v.kind);
             }
         }
-        let v = self.cand_local[ci].verdict;
+        let v = self.cand[ci].verdict;
         if v.kind != KIND_LOCAL {
             if let Some(a) = self.still_holds(c, &v, &self.base_cert) {
                 return (a, v.kind);
@@ -329,7 +329,7 @@ impl State<'_> {
             "tree_push({c}): a triangle of the pair is already used"
         );
         let ci = c as usize;
-        let [t0, t1] = self.cand_local[ci].pair;
+        let [t0, t1] = self.cand[ci].pair;
         // Only a split changes more than the polder's size.
         let split = self.tree_verdict(c).1 == KIND_SPLIT;
         self.log.push(Op::TreeApply(c));
@@ -364,7 +364,7 @@ impl State<'_> {
             }
         }
         self.remaining -= 2;
-        let q = self.cand_local[ci].quad;
+        let q = self.cand[ci].quad;
         for i in 1..4 {
             self.union(q[0], q[i]);
         }
@@ -394,7 +394,7 @@ impl State<'_> {
         let c = tr.path.pop().expect("a pushed action");
         let n = tr.changed_len.pop().expect("logged");
         tr.changed.truncate(n);
-        for v in self.cand_local[c as usize].quad.into_iter().rev() {
+        for v in self.cand[c as usize].quad.into_iter().rev() {
             tr.touched_at[v as usize] = tr.touched_log.pop().expect("logged");
         }
         tr.serial.pop();
@@ -405,7 +405,7 @@ impl State<'_> {
             let Op::TreeApply(c) = op else {
                 unreachable!("a base change inside a look-ahead tree");
             };
-            for x in self.cand_local[c as usize].pair {
+            for x in self.cand[c as usize].pair {
                 self.alive[x as usize] = true;
                 self.stamp[x as usize] = 0;
                 for v in self.verts(x) {
@@ -498,15 +498,15 @@ impl State<'_> {
     pub fn tree_affected(&self, out: &mut Vec<u32>) {
         let tr = &self.tree;
         for &c in &tr.path {
-            for x in self.cand_local[c as usize].pair {
+            for x in self.cand[c as usize].pair {
                 out.extend(self.tri[x as usize].cands.iter().filter(|&&c2| c2 != NONE));
                 for &(c2, ver) in &self.watch[x as usize] {
-                    if self.cand_local[c2 as usize].cert_ver == ver {
+                    if self.cand[c2 as usize].cert_ver == ver {
                         out.push(c2);
                     }
                 }
             }
-            for v in self.cand_local[c as usize].quad {
+            for v in self.cand[c as usize].quad {
                 let v = v as usize;
                 out.extend(&self.vc_list[self.vc_start[v] as usize..self.vc_start[v + 1] as usize]);
             }
@@ -514,7 +514,7 @@ impl State<'_> {
         for op in &self.log[tr.log_start..] {
             if let Op::Union { child, .. } = *op {
                 for &(c2, ver) in &self.root_watch[child as usize] {
-                    if self.cand_local[c2 as usize].cert_ver == ver {
+                    if self.cand[c2 as usize].cert_ver == ver {
                         out.push(c2);
                     }
                 }
@@ -524,7 +524,7 @@ impl State<'_> {
         // takes a split on the path (otherwise every polder lost an even number).
         if !tr.changed.is_empty() {
             for &c2 in &self.split {
-                let t0 = self.cand_local[c2 as usize].pair[0];
+                let t0 = self.cand[c2 as usize].pair[0];
                 if self.is_live(c2) && tr.changed.contains(&self.polder[t0 as usize]) {
                     out.push(c2);
                 }
@@ -547,7 +547,7 @@ impl State<'_> {
         }
         let epoch = tr.affected_epoch;
         for &c in &cands {
-            for t in self.cand_local[c as usize].pair {
+            for t in self.cand[c as usize].pair {
                 if tr.affected_mark[t as usize] != epoch {
                     tr.affected_mark[t as usize] = epoch;
                     tr.affected.push(t);
