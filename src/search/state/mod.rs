@@ -37,10 +37,10 @@
 //!   else recomputed. `P_min` inside the tree (rare) is the base sets corrected by the
 //!   triangles the path can have changed.
 //! * **Layout.** What is read together is stored together: one 64-byte record per candidate
-//!   (quad, neighbours, pair, verdict and its version) and one per triangle (its ring of
-//!   vertices, neighbours, candidates), so that touching an element costs one cache line;
-//!   the lockstep search, which streams through many triangles for their neighbours only,
-//!   reads the mesh's dense dual graph instead.
+//!   (quad, neighbours, pair, verdict, its version and stale mark) and one per triangle
+//!   (its ring of vertices, neighbours, candidates), so that touching an element costs one
+//!   cache line; the lockstep search, which streams through many triangles for their
+//!   neighbours only, reads the mesh's dense dual graph instead.
 
 #![allow(clippy::needless_range_loop)] // index loops over the 4 quad sides read best
 
@@ -64,7 +64,7 @@ const KIND_SPLIT: u8 = 2;
 /// one part. Depends on those components staying distinct.
 const KIND_DISTINCT: u8 = 3;
 /// Per candidate, on one cache line (64 bytes, aligned): what the local proof reads, its
-/// pair, its verdict and the verdict's version, which are read together.
+/// pair, its verdict, the verdict's version and stale mark, which are read together.
 #[derive(Debug, Clone, Copy)]
 #[repr(align(64))]
 struct CandRecord {
@@ -83,6 +83,8 @@ struct CandRecord {
     flags: u8,
     /// One triangle neighbours the quad across two of its sides (no local proof then).
     shared: bool,
+    /// The verdict was marked possibly stale by an action and not yet rechecked.
+    dirty: bool,
 }
 const _: () = assert!(std::mem::size_of::<CandRecord>() == 64);
 
@@ -186,7 +188,7 @@ pub struct State<'a> {
     // ---- static ----
     /// Vertex fan is one closed cycle of triangles in the dual graph.
     closed: Vec<bool>,
-    /// Per candidate: its quad, neighbours, pair, verdict and version (one cache line).
+    /// Per candidate: its quad, neighbours, pair, verdict, version, stale mark (one cache line).
     cand: Vec<CandRecord>,
     /// Per triangle: its ring of vertices, neighbours and candidates.
     tri: Vec<TriRecord>,
@@ -217,8 +219,7 @@ pub struct State<'a> {
     narcs: usize,
     split: Vec<u32>,
     split_pos: Vec<u32>,
-    /// Verdicts marked possibly stale by an action and not yet rechecked.
-    dirty: Vec<bool>,
+    /// Verdicts marked possibly stale and not yet rechecked (their records say `dirty`).
     dirty_list: Vec<u32>,
     chosen: Vec<u32>,
     quality: Vec<f64>,
@@ -363,6 +364,7 @@ impl<'a> State<'a> {
                     cert_ver: 0,
                     flags: 0,
                     shared: false,
+                    dirty: false,
                 };
                 for i in 0..4 {
                     if closed[quad[i] as usize] {
@@ -420,7 +422,6 @@ impl<'a> State<'a> {
             narcs: 0,
             split: Vec::new(),
             split_pos: vec![NONE; m],
-            dirty: vec![false; m],
             dirty_list: Vec::new(),
             chosen: Vec::new(),
             quality: vec![0.0],
@@ -850,8 +851,8 @@ impl<'a> State<'a> {
     /// Marks the verdict of `c` as possibly stale (logged).
     fn mark(&mut self, c: u32) {
         let ci = c as usize;
-        if !self.dirty[ci] {
-            self.dirty[ci] = true;
+        if !self.cand[ci].dirty {
+            self.cand[ci].dirty = true;
             self.dirty_list.push(c);
             self.base_log(Op::Dirty);
         }
@@ -860,7 +861,7 @@ impl<'a> State<'a> {
     /// Makes the verdict of `c` exact (rechecks it if it was marked stale).
     #[inline]
     pub(crate) fn resolve(&mut self, c: u32) {
-        if self.dirty[c as usize] {
+        if self.cand[c as usize].dirty {
             self.resolve_slow(c);
         }
     }
@@ -869,7 +870,7 @@ impl<'a> State<'a> {
         if self.is_live(c) {
             self.recheck_one(c);
         }
-        self.dirty[c as usize] = false;
+        self.cand[c as usize].dirty = false;
         self.base_log(Op::Clean(c));
     }
 
@@ -877,7 +878,7 @@ impl<'a> State<'a> {
     pub fn resolve_all(&mut self) {
         while let Some(c) = self.dirty_list.pop() {
             self.base_log(Op::DirtyPop(c));
-            if self.dirty[c as usize] {
+            if self.cand[c as usize].dirty {
                 self.resolve_slow(c);
             }
         }
@@ -932,7 +933,7 @@ impl<'a> State<'a> {
         // parts are relabelled).
         let v = self.cand[ci].verdict;
         let exact_before = self.dirty_list.is_empty();
-        let r = if !self.dirty[ci] && v.allowed && v.kind != KIND_SPLIT {
+        let r = if !self.cand[ci].dirty && v.allowed && v.kind != KIND_SPLIT {
             v
         } else {
             self.check(c)
@@ -1085,9 +1086,9 @@ impl<'a> State<'a> {
                 }
                 Op::Dirty => {
                     let c = self.dirty_list.pop().expect("dirty entry");
-                    self.dirty[c as usize] = false;
+                    self.cand[c as usize].dirty = false;
                 }
-                Op::Clean(c) => self.dirty[c as usize] = true,
+                Op::Clean(c) => self.cand[c as usize].dirty = true,
                 Op::DirtyPop(c) => self.dirty_list.push(c),
                 Op::SplitRem { c, pos } => {
                     let p = pos as usize;
@@ -1172,7 +1173,7 @@ impl<'a> State<'a> {
         }
         self.ver = init.ver;
         for &c in &self.dirty_list {
-            self.dirty[c as usize] = false;
+            self.cand[c as usize].dirty = false;
         }
         self.dirty_list.clear();
         self.alive.iter_mut().for_each(|a| *a = true);
@@ -1207,7 +1208,7 @@ impl<'a> State<'a> {
     /// verdicts against a from-scratch evaluation of the criterion. O(n) per candidate:
     /// for tests only.
     pub fn sanity_check(&self) -> Result<(), String> {
-        if let Some(c) = (0..self.dirty.len()).find(|&c| self.dirty[c]) {
+        if let Some(c) = (0..self.cand.len()).find(|&c| self.cand[c].dirty) {
             return Err(format!("candidate {c} still marked stale"));
         }
         let nt = self.alive.len();
