@@ -57,11 +57,7 @@ impl Bound {
     }
 
     fn prunes(&self, partial: f64, d: u32) -> bool {
-        let mut top = partial;
-        for _ in d..self.h {
-            top += 1.0;
-        }
-        top + BOUND_SLACK < self.best
+        partial + f64::from(self.h - d) + BOUND_SLACK < self.best
     }
 }
 

@@ -26,15 +26,18 @@ pub struct Args {
     loads: usize,
 }
 
-/// One random cycle through `0..n` as a successor table (Sattolo's algorithm).
-fn random_cycle(n: usize, rng: &mut ChaCha8Rng) -> Vec<u64> {
-    let mut order: Vec<u64> = (0..n as u64).collect();
+/// One random cycle through `0..n` as a successor table (Sattolo's algorithm); `None` when
+/// the memory cannot be had.
+fn random_cycle(n: usize, rng: &mut ChaCha8Rng) -> Option<Vec<u64>> {
+    let mut order: Vec<u64> = Vec::new();
+    order.try_reserve_exact(n).ok()?;
+    order.extend(0..n as u64);
     for i in (1..n).rev() {
         let j = rng.random_range(0..i);
         order.swap(i, j);
     }
     // Sattolo's shuffle leaves a single n-cycle: `order` read as a successor table.
-    order
+    Some(order)
 }
 
 /// Nanoseconds per load of a chase of `loads` steps around `next`.
@@ -81,13 +84,24 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut rng = ChaCha8Rng::seed_from_u64(2026);
     let mut mib = 1;
     while mib <= args.max_mib {
-        let next = random_cycle(mib << 17, &mut rng);
+        let Some(next) = mib
+            .checked_mul(1 << 17)
+            .and_then(|n| random_cycle(n, &mut rng))
+        else {
+            return Err(BadInput(format!(
+                "cannot allocate {mib} MiB for the working set: lower --max-mib"
+            ))
+            .into());
+        };
         // A first pass faults the pages in and warms what fits in the caches.
         dependent_ns(&next, next.len().min(args.loads));
         let dep = dependent_ns(&next, args.loads);
         let ind = independent_ns(&next, args.loads);
         println!("{mib:>8} {dep:>14.1} {ind:>16.1} {:>8.1}", dep / ind);
-        mib *= 2;
+        let Some(twice) = mib.checked_mul(2) else {
+            break;
+        };
+        mib = twice;
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -100,7 +114,7 @@ mod tests {
     fn the_chase_visits_every_slot_once_per_cycle() {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         for n in [2, 3, 10, 1000] {
-            let next = random_cycle(n, &mut rng);
+            let next = random_cycle(n, &mut rng).expect("a few KiB");
             let mut seen = vec![false; n];
             let mut p = 0usize;
             for _ in 0..n {

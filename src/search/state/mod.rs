@@ -530,7 +530,7 @@ impl<'a> State<'a> {
     /// Every allowed action, in increasing candidate order (O(candidates); for tests).
     pub fn allowed_actions(&self) -> Vec<u32> {
         (0..self.table.len() as u32)
-            .filter(|&c| self.cand[c as usize].verdict.allowed)
+            .filter(|&c| self.is_allowed(c))
             .collect()
     }
 
