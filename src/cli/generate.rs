@@ -2,8 +2,8 @@
 //! MSH 4.1 ASCII.
 
 use super::BadInput;
+use quadrecomb::mesh::Recombined;
 use quadrecomb::mesh::generate::{self, GridSpec, MAX_SUBDIVISIONS};
-use quadrecomb::mesh::{Recombined, msh};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -84,7 +84,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Shape::Icosphere(a) => {
             let s = match (a.subdivisions, a.triangles) {
                 (Some(s), _) => s,
-                (None, Some(n)) => generate::subdivisions_for(n),
+                (None, Some(n)) => {
+                    let largest = 20usize << (2 * MAX_SUBDIVISIONS);
+                    if n > 2 * largest {
+                        return Err(BadInput(format!(
+                            "--triangles {n}: the largest icosphere has {largest} triangles \
+                             ({MAX_SUBDIVISIONS} subdivisions)"
+                        ))
+                        .into());
+                    }
+                    generate::subdivisions_for(n)
+                }
                 (None, None) => unreachable!("clap requires one of them"),
             };
             if s > MAX_SUBDIVISIONS {
@@ -103,7 +113,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let generated = start.elapsed().as_secs_f64();
     let start = Instant::now();
-    msh::write(&output, &mesh, &Recombined::unrecombined(&mesh))?;
+    super::write_mesh_output(&output, &mesh, &Recombined::unrecombined(&mesh))?;
     let written = start.elapsed().as_secs_f64();
     println!(
         "wrote {}: {} triangles, {} vertices ({what}); generated in {generated:.3} s, written in {written:.3} s",

@@ -89,28 +89,71 @@ pub fn describe(err: &anyhow::Error) -> String {
     out
 }
 
-/// Checks before any work that an output path names a `.msh` or `.vtu` file.
+/// Checks before any work that an output path names a `.msh` or `.vtu` file (any case) in
+/// a directory that exists, so that a long run does not end on a path it cannot write.
 pub fn check_mesh_output(path: Option<&std::path::Path>) -> Result<(), BadInput> {
-    match path {
-        Some(p) if !matches!(p.extension().and_then(|e| e.to_str()), Some("msh" | "vtu")) => {
-            Err(BadInput(format!(
-                "output {}: expected a .msh or .vtu file name",
-                p.display()
-            )))
-        }
-        _ => Ok(()),
+    let Some(p) = path else {
+        return Ok(());
+    };
+    if output_kind(p).is_none() {
+        return Err(BadInput(format!(
+            "output {}: expected a .msh or .vtu file name",
+            p.display()
+        )));
+    }
+    if p.is_dir() {
+        return Err(BadInput(format!("output {}: is a directory", p.display())));
+    }
+    let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+    if let Some(dir) = dir.filter(|d| !d.is_dir()) {
+        return Err(BadInput(format!(
+            "output {}: directory {} does not exist",
+            p.display(),
+            dir.display()
+        )));
+    }
+    Ok(())
+}
+
+/// `Some(true)` for a `.vtu` path, `Some(false)` for `.msh`, `None` otherwise (any case).
+fn output_kind(path: &std::path::Path) -> Option<bool> {
+    let ext = path.extension()?;
+    if ext.eq_ignore_ascii_case("vtu") {
+        Some(true)
+    } else if ext.eq_ignore_ascii_case("msh") {
+        Some(false)
+    } else {
+        None
     }
 }
 
-/// Writes a recombined mesh as VTU (`.vtu`) or MSH 4.1 ASCII (anything else).
+/// Writes a recombined mesh as VTU (`.vtu`) or MSH 4.1 ASCII (`.msh`), through a temporary
+/// file in the same directory renamed over `path`, so that a failed or interrupted write
+/// never leaves a partial mesh behind.
 pub fn write_mesh_output(
     path: &std::path::Path,
     mesh: &quadrecomb::mesh::Mesh,
     rec: &quadrecomb::mesh::Recombined,
-) -> Result<(), quadrecomb::mesh::ReadError> {
-    if path.extension().is_some_and(|e| e == "vtu") {
-        quadrecomb::mesh::vtu::write(path, mesh, rec)
-    } else {
-        quadrecomb::mesh::msh::write(path, mesh, rec)
-    }
+) -> Result<(), BadInput> {
+    use std::io::Write;
+    let fail = |e: &dyn std::fmt::Display| {
+        BadInput(format!("cannot write output {}: {e}", path.display()))
+    };
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(format!(".tmp-{}", std::process::id()));
+    let tmp = std::path::PathBuf::from(tmp);
+    let written = (|| -> std::io::Result<()> {
+        let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+        if output_kind(path) == Some(true) {
+            quadrecomb::mesh::vtu::write_to(&mut w, mesh, rec)?;
+        } else {
+            quadrecomb::mesh::msh::write_to(&mut w, mesh, rec)?;
+        }
+        w.flush()?;
+        std::fs::rename(&tmp, path)
+    })();
+    written.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        fail(&e)
+    })
 }

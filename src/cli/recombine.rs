@@ -1,6 +1,7 @@
 //! `quadrecomb recombine`: one run of one policy on one mesh.
 
 use super::BadInput;
+use quadrecomb::gpu::{Backend, Evaluator};
 use quadrecomb::quality::{self, CandidateTable};
 use quadrecomb::search::{self, Algo, optimum};
 use std::path::PathBuf;
@@ -19,6 +20,18 @@ enum AlgoName {
     Selective,
 }
 
+/// Who computes eta.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum EtaBackend {
+    /// The f64 reference (`CandidateTable::build`).
+    Exact,
+    /// The CPU twin of the GPU kernel (f32), what `sweep --backend cpu` records as
+    /// `cpu-twin`.
+    Cpu,
+    /// The GPU kernel on a Vulkan adapter (lavapipe included), as `sweep --backend gpu`.
+    Gpu,
+}
+
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Mesh file (.msh) or built-in name (borouchaki, sphere).
@@ -26,9 +39,9 @@ pub struct Args {
     /// Policy.
     #[arg(long, value_enum)]
     algo: AlgoName,
-    /// Horizon of the uniform / selective tree.
-    #[arg(long, default_value_t = 1)]
-    horizon: u32,
+    /// Horizon of the uniform / selective tree (default 1; the greedy policies have none).
+    #[arg(long)]
+    horizon: Option<u32>,
     /// Seed of the run (ChaCha8: the same seed gives the same run everywhere).
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -41,6 +54,27 @@ pub struct Args {
     /// Do not compute the exact optimum (skips `quality_pct`).
     #[arg(long)]
     no_optimum: bool,
+    /// Who computes eta. Runs are exact given the eta table, but the f32 kernel's values
+    /// differ from the f64 reference in the last bits, which can change ties and so the
+    /// run: to repeat a sweep's run, pass its record's `seed` and `--backend cpu` (records
+    /// with backend `cpu-twin`) or `--backend gpu` (a `vulkan: ...` backend).
+    #[arg(long, value_enum, default_value_t = EtaBackend::Exact)]
+    backend: EtaBackend,
+}
+
+/// The candidate table of `mesh` with eta from `backend`, and the evaluator's name.
+pub fn eta_table(
+    mesh: &quadrecomb::mesh::Mesh,
+    backend: EtaBackend,
+) -> anyhow::Result<(CandidateTable, String)> {
+    let ev = match backend {
+        EtaBackend::Exact => return Ok((CandidateTable::build(mesh), "exact".into())),
+        EtaBackend::Cpu => Evaluator::cpu_twin(),
+        EtaBackend::Gpu => Evaluator::new(Backend::Gpu)?,
+    };
+    let mut table = CandidateTable::topology_only(mesh);
+    ev.fill(&mut [(mesh, &mut table)])?;
+    Ok((table, ev.name().to_string()))
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -50,10 +84,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         AlgoName::Uniform => "uniform",
         AlgoName::Selective => "selective",
     };
-    let algo = Algo::from_name(name, args.horizon).map_err(|e| BadInput(e.to_string()))?;
+    let algo =
+        Algo::from_name(name, args.horizon.unwrap_or(1)).map_err(|e| BadInput(e.to_string()))?;
+    if args.horizon.is_some() && matches!(algo, Algo::GreedyNocrit | Algo::Greedy) {
+        eprintln!("note: --horizon is ignored: {name} looks no further than one action");
+    }
     super::check_mesh_output(args.output.as_deref())?;
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
-    let table = CandidateTable::build(&mesh);
+    let (table, backend) = eta_table(&mesh, args.backend)?;
     let out = search::run(&mesh, &table, algo, args.seed);
     let nt = mesh.num_triangles();
     let recombined_pct = 100.0 * (2 * out.quads) as f64 / nt as f64;
@@ -85,6 +123,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "nodes_expanded": out.nodes_expanded,
             "trees": out.trees,
             "decisions": out.decisions,
+            "backend": backend,
         });
         if let Some(p) = quality_pct {
             v["quality_pct"] = serde_json::json!(p);
@@ -98,6 +137,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             Some(h) => println!("algo            {} (horizon {h}, seed {})", algo, args.seed),
             None => println!("algo            {} (seed {})", algo, args.seed),
         }
+        println!("eta             {backend}");
         println!("quads           {}", out.quads);
         println!("triangles left  {}", out.triangles_left);
         println!("recombined      {recombined_pct:.2} %");

@@ -115,6 +115,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         };
         PathBuf::from("results").join(name)
     });
+    if out.exists() && !out.is_dir() {
+        return Err(BadInput(format!(
+            "--out {}: exists and is not a directory",
+            out.display()
+        ))
+        .into());
+    }
     let config = SweepConfig {
         meshes,
         algos: if args.algos.is_empty() {
@@ -191,7 +198,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 /// Marks errors caused by the user's input so that they exit with the bad-input code.
 pub(crate) fn bad_input(e: ExperimentError) -> anyhow::Error {
     if e.is_bad_input() {
-        let msg = format!("{:#}", anyhow::Error::from(e));
+        let msg = super::describe(&anyhow::Error::from(e));
         anyhow::Error::new(BadInput(msg))
     } else {
         anyhow::Error::new(e)

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use super::ExperimentError;
 use super::engine::check_records;
-use super::manifest::{Manifest, MergedPart};
+use super::manifest::{MANIFEST_FILE, Manifest, MergedPart};
 use super::plan::plan;
 use super::record::{RunKey, RunRecord};
 use super::store::{self, RUNS_FILE, RunLog};
@@ -31,6 +31,18 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     }
     let mut manifests = Vec::new();
     for p in parts {
+        if !p.is_dir() {
+            return Err(ExperimentError::Merge(format!(
+                "{}: no such results directory",
+                p.display()
+            )));
+        }
+        if !p.join(MANIFEST_FILE).is_file() {
+            return Err(ExperimentError::Merge(format!(
+                "{}: not a sweep's results directory (no {MANIFEST_FILE})",
+                p.display()
+            )));
+        }
         manifests.push(Manifest::read(p)?);
     }
     let first = &manifests[0];
@@ -94,7 +106,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     let out_runs = out.join(RUNS_FILE);
     let existing = store::read(&out_runs)?;
     if !existing.records.is_empty() || existing.torn_bytes > 0 {
-        return Err(ExperimentError::AlreadyExists {
+        return Err(ExperimentError::MergeTargetNotEmpty {
             dir: out.to_path_buf(),
             records: existing.records.len(),
         });
@@ -195,7 +207,7 @@ mod tests {
         // Merging again into the same directory is refused.
         assert!(matches!(
             merge(&parts, &out),
-            Err(ExperimentError::AlreadyExists { .. })
+            Err(ExperimentError::MergeTargetNotEmpty { .. })
         ));
     }
 

@@ -60,6 +60,16 @@ pub enum ExperimentError {
         /// Records found.
         records: usize,
     },
+    /// `merge` was pointed at a directory that already holds runs.
+    #[error(
+        "{dir}: already holds {records} run(s); merge writes into a new or empty directory: choose another --out or remove that one"
+    )]
+    MergeTargetNotEmpty {
+        /// The directory.
+        dir: PathBuf,
+        /// Records found.
+        records: usize,
+    },
     /// Another live process is writing the results directory.
     #[error(
         "{dir}: another sweep (process {pid}) is writing there; wait for it, stop it, or choose another --out"
@@ -109,6 +119,7 @@ impl ExperimentError {
             ExperimentError::Corrupt { .. }
                 | ExperimentError::Mismatch { .. }
                 | ExperimentError::AlreadyExists { .. }
+                | ExperimentError::MergeTargetNotEmpty { .. }
                 | ExperimentError::Busy { .. }
                 | ExperimentError::Merge(_)
                 | ExperimentError::Invalid(_)

@@ -107,6 +107,17 @@ impl SweepConfig {
                 return bad("--runs must be at least 1".into());
             }
         }
+        if self.baseline_runs == 0 && self.algos.iter().any(|a| !has_horizon(a)) {
+            return bad(format!(
+                "--baseline-runs must be at least 1 (it is the number of runs of {})",
+                self.algos
+                    .iter()
+                    .filter(|a| !has_horizon(a))
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
         for (i, h) in self.horizons.iter().enumerate() {
             if self.horizons[..i].contains(h) {
                 return bad(format!("horizon {h} given twice"));

@@ -37,7 +37,15 @@ pub enum ReportError {
         /// The cause.
         source: std::io::Error,
     },
-    /// `runs.jsonl` is missing or holds no run.
+    /// The directory is missing or holds no `runs.jsonl`.
+    #[error("{dir}: {why}")]
+    NotResults {
+        /// The directory.
+        dir: PathBuf,
+        /// What is missing.
+        why: String,
+    },
+    /// `runs.jsonl` holds no run.
     #[error("{path}: no runs recorded")]
     NoRuns {
         /// The file.
@@ -46,6 +54,9 @@ pub enum ReportError {
     /// The runner's files (`runs.jsonl`, `manifest.json`) could not be read.
     #[error(transparent)]
     Results(#[from] crate::experiment::ExperimentError),
+    /// `--picture` names a configuration the results do not hold.
+    #[error("--picture {0}: no such configuration in these results (they hold: {1})")]
+    NoSuchPicture(String, String),
     /// plotters failed to draw (an internal error).
     #[error("drawing a figure failed: {0}")]
     Plot(String),
@@ -131,6 +142,7 @@ pub fn build(
     other: Option<&Results>,
     opts: &ReportOptions,
 ) -> Result<Document, ReportError> {
+    check_pictures(results, opts)?;
     let mut doc = Document::default();
     doc.heading(1, format!("quadrecomb report: {}", results.dir.display()));
     overview(&mut doc, results);
@@ -490,6 +502,31 @@ fn box_plots(
             )?;
             let file = format!("{FIGURES_DIR}/{stem}.svg");
             doc.figure(file, svg, caption);
+        }
+    }
+    Ok(())
+}
+
+/// Fails when a configuration asked for with `--picture` matches none of the results'.
+fn check_pictures(results: &Results, opts: &ReportOptions) -> Result<(), ReportError> {
+    let name = |a: &str, h: Option<u32>| match h {
+        Some(h) => format!("{a}:{h}"),
+        None => a.to_string(),
+    };
+    for (a, h) in &opts.picture_configs {
+        let found = results
+            .groups
+            .keys()
+            .any(|c| c.algo == *a && (h.is_none() || *h == c.horizon));
+        if !found {
+            let mut held: Vec<String> = Vec::new();
+            for c in results.groups.keys() {
+                let n = name(&c.algo, c.horizon);
+                if !held.contains(&n) {
+                    held.push(n);
+                }
+            }
+            return Err(ReportError::NoSuchPicture(name(a, *h), held.join(", ")));
         }
     }
     Ok(())

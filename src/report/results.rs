@@ -82,9 +82,22 @@ impl Results {
     /// Reads `dir/runs.jsonl` (through the runner's reader: a torn last line is ignored, any
     /// other bad line is an error) and, if present, `dir/manifest.json`.
     pub fn read(dir: &Path) -> Result<Results, ReportError> {
+        if !dir.is_dir() {
+            return Err(ReportError::NotResults {
+                dir: dir.to_path_buf(),
+                why: if dir.exists() {
+                    "not a directory (give the sweep's results directory)".into()
+                } else {
+                    "no such directory".into()
+                },
+            });
+        }
         let path = dir.join(store::RUNS_FILE);
         if !path.is_file() {
-            return Err(ReportError::NoRuns { path });
+            return Err(ReportError::NotResults {
+                dir: dir.to_path_buf(),
+                why: format!("no {} (not a sweep's results directory)", store::RUNS_FILE),
+            });
         }
         let loaded = store::read(&path)?;
         if loaded.records.is_empty() {

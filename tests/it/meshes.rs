@@ -773,6 +773,14 @@ fn cli_generate_rejects_bad_arguments_with_exit_code_2() {
         ],
         &[
             "generate",
+            "icosphere",
+            "--triangles",
+            "18446744073709551615",
+            "-o",
+            "x.msh",
+        ],
+        &[
+            "generate",
             "grid",
             "--triangles",
             "100",

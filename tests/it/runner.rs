@@ -421,9 +421,26 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     assert_eq!(dup.status.code(), Some(2));
     assert!(stderr(&dup).contains("is in both"), "{}", stderr(&dup));
 
+    let nodir = run_in(dir, &["merge", "p1", "nodir", "--out", "m5", "--no-report"]);
+    assert_eq!(nodir.status.code(), Some(2));
+    assert!(
+        stderr(&nodir).contains("nodir: no such results directory"),
+        "{}",
+        stderr(&nodir)
+    );
+
     // A successful merge writes the report of the merged results.
     let ok = run_in(dir, &["merge", "p1", "p2", "--out", "m4"]);
     assert!(ok.status.success(), "{}", stderr(&ok));
+    // Merging into a directory that holds runs is refused, with advice merge can follow.
+    let again = run_in(dir, &["merge", "p1", "p2", "--out", "m4", "--no-report"]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(
+        stderr(&again).contains("choose another --out"),
+        "{}",
+        stderr(&again)
+    );
+    assert!(!stderr(&again).contains("--resume"), "{}", stderr(&again));
     assert!(dir.join("m4/report.md").exists());
     // 2 horizons x 3 runs of selective + 2 greedy + 2 greedy-nocrit + 1 optimum.
     assert_eq!(records(&dir.join("m4")).len(), 2 * 3 + 2 + 2 + 1);
@@ -470,4 +487,59 @@ fn statistics_match_textbook_values() {
     assert_eq!((b.q1, b.median, b.q3), (3.5, 6.0, 8.5));
     assert_eq!((b.whisker_low, b.whisker_high), (1.0, 10.0));
     assert_eq!(b.outliers, vec![30.0]);
+}
+
+/// Arguments a sweep cannot follow are refused up front with exit code 2 and one clear line:
+/// baselines asked for with zero runs, an `--out` that is a file, a missing mesh (its cause
+/// said once).
+#[test]
+fn sweep_refuses_arguments_it_cannot_follow() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("afile"), "").unwrap();
+    for (args, expect) in [
+        (
+            &[
+                "--mesh",
+                "sphere",
+                "--algo",
+                "greedy",
+                "--baseline-runs",
+                "0",
+                "--out",
+                "a",
+            ][..],
+            "--baseline-runs must be at least 1 (it is the number of runs of greedy)",
+        ),
+        (
+            &[
+                "--mesh",
+                "sphere",
+                "--horizons",
+                "1",
+                "--runs",
+                "1",
+                "--out",
+                "afile",
+            ][..],
+            "--out afile: exists and is not a directory",
+        ),
+        (
+            &["--mesh", "nosuch.msh", "--out", "b"][..],
+            "nosuch.msh: No such file",
+        ),
+    ] {
+        let mut all = vec!["sweep", "--backend", "cpu", "--quiet"];
+        all.extend_from_slice(args);
+        let out = run_in(dir, &all);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(expect), "{args:?}: {err}");
+        assert!(
+            err.matches("No such file").count() <= 1,
+            "cause repeated: {err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+    }
+    assert!(!dir.join("a").exists() && !dir.join("b").join("runs.jsonl").exists());
 }

@@ -479,10 +479,104 @@ fn recombine_cli_prints_json_and_writes_meshes() {
             "0",
         ][..],
         &["recombine", "sphere", "--algo", "greedy", "-o", "out.obj"][..],
+        // Output paths it could not write are refused before the search.
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "greedy",
+            "-o",
+            "no/such/dir/x.msh",
+        ][..],
+        &["recombine", "sphere", "--algo", "greedy", "-o", "."][..],
+        &["optimum", "sphere", "-o", "no/such/dir/x.vtu"][..],
     ] {
         let bad = crate::util::run_in(dir.path(), args);
-        assert_eq!(bad.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&bad.stderr);
+        assert_eq!(bad.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.starts_with("error: "), "{args:?}: {err}");
+        assert!(bad.stdout.is_empty(), "{args:?} ran before refusing");
     }
+    // Extensions in any case; the write goes through a temporary file renamed into place.
+    let upper = crate::util::run_in(
+        dir.path(),
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "greedy",
+            "-o",
+            "UP.MSH",
+            "--no-optimum",
+        ],
+    );
+    assert!(
+        upper.status.success(),
+        "{}",
+        String::from_utf8_lossy(&upper.stderr)
+    );
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(names.iter().any(|n| n == "UP.MSH"), "{names:?}");
+    assert!(!names.iter().any(|n| n.contains(".tmp")), "{names:?}");
+}
+
+/// `recombine --backend cpu` (the CPU twin's f32 eta) repeats a committed sweep's run from its
+/// recorded seed: same quads, same quality to the bit; the default f64 eta need not (ties
+/// fall otherwise on `sphere`: greedy makes 849 quads with it against the sweep's 870).
+#[test]
+fn recombine_backend_cpu_repeats_a_committed_sweep_run() {
+    let runs = std::fs::read_to_string(crate::util::repo_path("results/sphere/runs.jsonl"))
+        .expect("committed results/sphere");
+    let recs: Vec<serde_json::Value> = runs
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let pick = |algo: &str, h: Option<u64>| {
+        recs.iter()
+            .find(|r| r["algo"] == algo && r["horizon"].as_u64() == h && r["backend"] == "cpu-twin")
+            .unwrap_or_else(|| panic!("no {algo} {h:?} record"))
+    };
+    let dir = tempfile::tempdir().unwrap();
+    for (algo, h) in [("greedy", None), ("selective", Some(3))] {
+        let rec = pick(algo, h);
+        let seed = rec["seed"].as_u64().unwrap().to_string();
+        let mut args = vec!["recombine", "sphere", "--algo", algo, "--seed", &seed];
+        let hs = h.map(|h| h.to_string());
+        if let Some(hs) = &hs {
+            args.extend(["--horizon", hs]);
+        }
+        args.extend(["--backend", "cpu", "--json", "--no-optimum"]);
+        let out = crate::util::run_in(dir.path(), &args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["backend"], "cpu-twin");
+        assert_eq!(v["quads"], rec["quads"], "{algo} {h:?}");
+        assert_eq!(
+            v["quality"].as_f64().unwrap().to_bits(),
+            rec["quality"].as_f64().unwrap().to_bits(),
+            "{algo} {h:?}"
+        );
+    }
+    let exact = crate::util::run_in(
+        dir.path(),
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "greedy",
+            "--json",
+            "--no-optimum",
+        ],
+    );
+    let v: serde_json::Value = serde_json::from_slice(&exact.stdout).unwrap();
+    assert_eq!(v["backend"], "exact");
 }
 
 /// `bench memory` prints one row per working-set size (1, 2, 4 MiB up to `--max-mib`) with
