@@ -8,11 +8,13 @@
 use crate::mesh::{Mesh, NONE, Recombined};
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// Angle at `p` between the rays to `a` and `b`, in `[0, pi]`, robust for tiny and huge
-/// coordinates (atan2 of |cross| and dot). Degenerate rays give 0.
+/// Angle at `p` between the rays to `a` and `b`, in `[0, pi]` (atan2 of |cross| and dot).
+/// Degenerate rays give 0. Rays whose length is far from 1 are first rescaled (the angle
+/// does not depend on their lengths), so that the products neither overflow nor underflow:
+/// the same angle for coordinates scaled by 1e-150 or 1e150.
 pub fn angle(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
-    let u = [a[0] - p[0], a[1] - p[1], a[2] - p[2]];
-    let v = [b[0] - p[0], b[1] - p[1], b[2] - p[2]];
+    let u = unit_range([a[0] - p[0], a[1] - p[1], a[2] - p[2]]);
+    let v = unit_range([b[0] - p[0], b[1] - p[1], b[2] - p[2]]);
     let c = [
         u[1] * v[2] - u[2] * v[1],
         u[2] * v[0] - u[0] * v[2],
@@ -21,6 +23,19 @@ pub fn angle(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
     let cn = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
     let d = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
     cn.atan2(d)
+}
+
+/// `u` as it is when its largest component lies in `[1e-60, 1e60]` (products of two such
+/// vectors stay far from f64's limits), else divided by that component. Leaving the usual
+/// range alone keeps eta bit for bit what it was for every mesh of ordinary size.
+#[inline]
+fn unit_range(u: [f64; 3]) -> [f64; 3] {
+    let m = u[0].abs().max(u[1].abs()).max(u[2].abs());
+    if (1e-60..=1e60).contains(&m) || m == 0.0 || !m.is_finite() {
+        u
+    } else {
+        u.map(|x| x / m)
+    }
 }
 
 /// eta from the four interior angles of a quad: `max(0, 1 - 2/pi * max_k |pi/2 - alpha_k|)`,
@@ -190,6 +205,38 @@ mod tests {
             [1.0, 1.0, 0.0],
         ];
         assert_eq!(quad_eta(p), 0.0);
+    }
+
+    #[test]
+    fn eta_does_not_depend_on_the_scale() {
+        // A jittered quad and the 60-degree rhombus, scaled from 1e-300 to 1e300: eta within
+        // rounding of the unscaled value (before the rescaling, squares under- or overflowed
+        // past 1e-77 and 1e77: eta 0, or 1 - 5e-13 instead of 1).
+        let h = 3f64.sqrt() / 2.0;
+        for p in [
+            [
+                [0.0, 0.0, 0.0],
+                [0.5, -h, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.5, h, 0.0],
+            ],
+            [
+                [0.1, -0.05, 0.0],
+                [1.02, 0.03, 0.01],
+                [0.97, 1.1, -0.02],
+                [-0.04, 0.93, 0.0],
+            ],
+        ] {
+            let want = quad_eta(p);
+            assert!(want > 0.5);
+            for s in [
+                1e-300, 1e-160, 1e-100, 1e-78, 1e-30, 1e30, 1e78, 1e100, 1e160, 1e300,
+            ] {
+                let q = p.map(|v| v.map(|x| x * s));
+                let got = quad_eta(q);
+                assert!((got - want).abs() < 1e-12, "scale {s:e}: {got} vs {want}");
+            }
+        }
     }
 
     #[test]

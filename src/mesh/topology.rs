@@ -57,9 +57,16 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
     assert_eq!(data.triangle_surface.len(), nt, "one surface per triangle");
     for (t, tri) in data.triangles.iter().enumerate() {
         let [a, b, c] = tri.map(|v| data.vertices[v as usize]);
-        let (u, w) = (sub(b, a), sub(c, a));
+        let (mut u, mut w) = (sub(b, a), sub(c, a));
+        // The test is scale-free: bring the largest component to 1 so that the squares below
+        // neither overflow nor underflow for very large or very small coordinates.
+        let m = u.iter().chain(&w).fold(0.0f64, |m, x| m.max(x.abs()));
+        if m > 0.0 && m.is_finite() {
+            u = u.map(|x| x / m);
+            w = w.map(|x| x / m);
+        }
         let area2 = norm(cross(u, w));
-        let scale = dot(u, u).max(dot(w, w)).max(dot(sub(c, b), sub(c, b)));
+        let scale = dot(u, u).max(dot(w, w)).max(dot(sub(w, u), sub(w, u)));
         if area2 <= 1e-14 * scale || scale == 0.0 {
             return Err(MeshError::DegenerateTriangle {
                 element: data.triangle_ids[t],

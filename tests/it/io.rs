@@ -419,6 +419,10 @@ fn bad_input_missing_file() {
 #[test]
 fn bad_input_unknown_format_and_version() {
     assert_bad(&bad("unknown_format.msh"), &["unknown mesh format"]);
+    let dir = tempfile::tempdir().unwrap();
+    let empty = dir.path().join("zero_bytes.msh");
+    std::fs::write(&empty, "").unwrap();
+    assert_bad(&empty, &[":1:", "the file is empty"]);
     assert_bad(
         &bad("unsupported_version.msh"),
         &[":2:", "unsupported MSH version `3.0`"],
@@ -915,4 +919,48 @@ fn info_reports_a_quad_only_mesh() {
         err.contains("bad_quads.msh") && err.contains("element 3"),
         "{err}"
     );
+}
+
+/// Meshes in any unit: a 2 x 1 grid of unit squares (four triangles) scaled by 1e-150 to
+/// 1e150 loads (no false "degenerate"), and both eta backends recombine it into two perfect
+/// quads (quality 2).
+#[test]
+fn coordinates_far_from_one_keep_their_geometry() {
+    let dir = tempfile::tempdir().unwrap();
+    for s in [1e-150, 1e-100, 1e-80, 1.0, 1e80, 1e100, 1e150] {
+        let mut text = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n6\n");
+        for (i, (x, y)) in [(0., 0.), (1., 0.), (2., 0.), (0., 1.), (1., 1.), (2., 1.)]
+            .iter()
+            .enumerate()
+        {
+            text += &format!("{} {:e} {:e} 0\n", i + 1, x * s, y * s);
+        }
+        text += "$EndNodes\n$Elements\n4\n1 2 2 0 1 1 2 5\n2 2 2 0 1 1 5 4\n";
+        text += "3 2 2 0 1 2 3 6\n4 2 2 0 1 2 6 5\n$EndElements\n";
+        let path = dir.path().join("scaled.msh");
+        std::fs::write(&path, text).unwrap();
+        for backend in ["exact", "cpu"] {
+            let out = run_in(
+                dir.path(),
+                &[
+                    "recombine",
+                    "scaled.msh",
+                    "--algo",
+                    "greedy",
+                    "--backend",
+                    backend,
+                    "--json",
+                ],
+            );
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(out.status.success(), "scale {s:e}, {backend}: {err}");
+            let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            assert_eq!(v["quads"], 2, "scale {s:e}, {backend}");
+            let q = v["quality"].as_f64().unwrap();
+            assert!(
+                (q - 2.0).abs() < 1e-5,
+                "scale {s:e}, {backend}: quality {q}"
+            );
+        }
+    }
 }

@@ -403,6 +403,13 @@ pub(super) fn looks_like_msh(bytes: &[u8]) -> bool {
 }
 
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
+    if bytes.iter().all(|c| c.is_ascii_whitespace()) {
+        return Err(ReadError::Syntax {
+            path: path.to_path_buf(),
+            line: 1,
+            message: "the file is empty".into(),
+        });
+    }
     if !looks_like_msh(bytes) {
         return Err(ReadError::UnknownFormat {
             path: path.to_path_buf(),
