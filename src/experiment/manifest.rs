@@ -53,17 +53,29 @@ pub struct SweepSpec {
     pub seed: u64,
 }
 
-/// One mesh of a sweep.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+/// One mesh of a sweep. Two entries are the same mesh when their name, content hash and
+/// size agree, wherever the file was read from (shards run from other directories, or a
+/// resume from another one, give the same path differently).
+#[derive(Debug, Clone, Eq, Serialize, Deserialize)]
 pub struct MeshEntry {
     /// Name used in records (built-in name or file stem).
     pub name: String,
     /// What was given on the command line (built-in name or path).
     pub source: String,
+    /// The file's absolute path when the sweep read it (none for a built-in mesh), so that
+    /// `report` finds the mesh from any working directory.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<String>,
     /// blake3 hex digest of the mesh's canonical content.
     pub hash: String,
     /// Number of triangles.
     pub triangles: usize,
+}
+
+impl PartialEq for MeshEntry {
+    fn eq(&self, other: &MeshEntry) -> bool {
+        self.name == other.name && self.hash == other.hash && self.triangles == other.triangles
+    }
 }
 
 /// The exact optimum of one mesh, with the eta it was computed from.

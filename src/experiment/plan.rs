@@ -106,12 +106,14 @@ pub(crate) mod tests {
                 MeshEntry {
                     name: "a".into(),
                     source: "a".into(),
+                    path: None,
                     hash: "aa".into(),
                     triangles: 10,
                 },
                 MeshEntry {
                     name: "b".into(),
                     source: "b.msh".into(),
+                    path: None,
                     hash: "bb".into(),
                     triangles: 20,
                 },

@@ -165,6 +165,11 @@ pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
         let entry = MeshEntry {
             name: mesh_name(spec),
             source: spec.clone(),
+            // The loader prefers a file over a built-in of the same name.
+            path: std::fs::canonicalize(spec)
+                .ok()
+                .filter(|p| p.is_file())
+                .map(|p| p.to_string_lossy().into_owned()),
             hash: mesh_hash(&mesh),
             triangles: mesh.num_triangles(),
         };

@@ -103,20 +103,20 @@ impl Rerunner {
 /// table that matches the sweep's.
 fn prepare(results: &Results, run: &Run) -> Result<Prepared, String> {
     let manifest = results.manifest.as_ref();
-    let source = manifest
-        .and_then(|m| m.spec.meshes.iter().find(|e| e.name == run.mesh))
-        .map_or(run.mesh.clone(), |e| e.source.clone());
-    // A relative path is tried as given, then relative to the results directory.
-    let mesh = crate::mesh::load(&source)
-        .or_else(|first| {
-            let beside = results.dir.join(&source);
-            if beside.is_file() {
-                crate::mesh::load(&beside.to_string_lossy())
-            } else {
-                Err(first)
-            }
-        })
-        .map_err(|e| format!("cannot load mesh {source}: {e}"))?;
+    let entry = manifest.and_then(|m| m.spec.meshes.iter().find(|e| e.name == run.mesh));
+    let source = entry.map_or(run.mesh.clone(), |e| e.source.clone());
+    // The source as given (from this working directory), then the absolute path the sweep
+    // recorded, then the source relative to the results directory.
+    let mut tries = vec![source.clone()];
+    tries.extend(entry.and_then(|e| e.path.clone()));
+    tries.push(results.dir.join(&source).to_string_lossy().into_owned());
+    let mut loaded = crate::mesh::load(&tries[0]);
+    for alt in &tries[1..] {
+        if loaded.is_err() && std::path::Path::new(alt).is_file() {
+            loaded = crate::mesh::load(alt);
+        }
+    }
+    let mesh = loaded.map_err(|e| format!("cannot load mesh {source}: {e}"))?;
     let hash = mesh_hash(&mesh);
     if !run.mesh_hash.is_empty() && hash != run.mesh_hash {
         return Err(format!(

@@ -299,6 +299,7 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
             meshes: vec![MeshEntry {
                 name: "sphere".into(),
                 source: "sphere".into(),
+                path: None,
                 hash: hash.clone(),
                 triangles: 2104,
             }],

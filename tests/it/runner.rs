@@ -543,3 +543,42 @@ fn sweep_refuses_arguments_it_cannot_follow() {
     }
     assert!(!dir.join("a").exists() && !dir.join("b").join("runs.jsonl").exists());
 }
+
+/// Shards run from different working directories (the mesh given by different relative
+/// paths) merge, and the merged report finds the mesh for its pictures from any directory:
+/// the manifest compares meshes by name and content and records the file's absolute path.
+#[test]
+fn shards_from_other_directories_merge_and_report_finds_the_mesh() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    small_mesh(dir, 300);
+    let sub = dir.join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let a = sweep(
+        dir,
+        &sweep_args(Path::new("small.msh"), "p1", 2, "1"),
+        &["--shard", "1/2"],
+    );
+    assert!(a.status.success(), "{}", stderr(&a));
+    let b = sweep(
+        &sub,
+        &sweep_args(Path::new("../small.msh"), "../p2", 2, "1"),
+        &["--shard", "2/2"],
+    );
+    assert!(b.status.success(), "{}", stderr(&b));
+    let m = run_in(dir, &["merge", "p1", "p2", "--out", "m"]);
+    assert!(m.status.success(), "{}", stderr(&m));
+    let report = std::fs::read_to_string(dir.join("m/report.md")).unwrap();
+    assert!(
+        report.contains("![") && !report.contains("No picture"),
+        "{report}"
+    );
+    // From another directory, where `small.msh` does not resolve.
+    let r = run_in(&sub, &["report", "../m"]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let report = std::fs::read_to_string(dir.join("m/report.md")).unwrap();
+    assert!(
+        report.contains("![") && !report.contains("No picture"),
+        "{report}"
+    );
+}
