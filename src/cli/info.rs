@@ -119,7 +119,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             surfaces: data.surfaces().len(),
             components: 0,
             odd_components: 0,
-            boundary_edges: 0,
+            boundary_edges: quad_boundary_edges(&data.quads),
             candidate_pairs: 0,
             reoriented_triangles: 0,
             ignored_elements,
@@ -257,4 +257,17 @@ fn text(i: &Info) -> String {
         t.candidates
     );
     s
+}
+
+/// Edges used by exactly one quad (a mesh of quads only has no topology built).
+fn quad_boundary_edges(quads: &[[u32; 4]]) -> usize {
+    let mut edges: Vec<(u32, u32)> = quads
+        .iter()
+        .flat_map(|q| (0..4).map(move |i| (q[i].min(q[(i + 1) % 4]), q[i].max(q[(i + 1) % 4]))))
+        .collect();
+    edges.sort_unstable();
+    edges
+        .chunk_by(|a, b| a == b)
+        .filter(|run| run.len() == 1)
+        .count()
 }

@@ -9,7 +9,9 @@ use std::process::ExitCode;
 pub struct Args {
     /// Mesh file (.msh) or built-in name.
     mesh: String,
-    /// Print one JSON object (the fields of `recombine --json`, algo "optimum").
+    /// Print one JSON object: the fields of `recombine --json` that apply (algo "optimum";
+    /// horizon, seed, nodes_expanded and trees null; no quality_pct), plus `check` with
+    /// --check.
     #[arg(long)]
     json: bool,
     /// Also verify the dual certificate of the matching (feasible duals, complementary

@@ -47,6 +47,19 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     }
     let first = &manifests[0];
     for (p, m) in parts.iter().zip(&manifests).skip(1) {
+        if let (Some(a), Some(b)) = (first.shard, m.shard)
+            && a.count != b.count
+        {
+            return Err(ExperimentError::Merge(format!(
+                "{} is shard {}/{} but {} is shard {}/{}: shards of one sweep share the same --shard count",
+                parts[0].display(),
+                a.index,
+                a.count,
+                p.display(),
+                b.index,
+                b.count
+            )));
+        }
         if let Some(why) = first.incompatibility(m) {
             return Err(ExperimentError::Merge(format!(
                 "{} and {} are not parts of the same sweep: {why}",

@@ -964,3 +964,53 @@ fn coordinates_far_from_one_keep_their_geometry() {
         }
     }
 }
+
+/// `info` on a mesh of quads only (a fully recombined grid) counts its boundary edges: the
+/// same as the triangle grid it came from.
+#[test]
+fn info_counts_the_boundary_of_a_quad_only_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let ok = |out: std::process::Output| {
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    };
+    ok(run_in(
+        dir.path(),
+        &["generate", "grid", "--triangles", "200", "-o", "g.msh"],
+    ));
+    ok(run_in(dir.path(), &["optimum", "g.msh", "-o", "q.msh"]));
+    let json = |f: &str| -> serde_json::Value {
+        serde_json::from_slice(&ok(run_in(dir.path(), &["info", f, "--json"])).stdout).unwrap()
+    };
+    let (tri, quad) = (json("g.msh"), json("q.msh"));
+    assert_eq!(quad["triangles"], 0, "{quad}");
+    assert!(tri["boundary_edges"].as_u64().unwrap() > 0);
+    assert_eq!(quad["boundary_edges"], tri["boundary_edges"]);
+}
+
+/// A lone triangle (nothing to pair) gives quality 0, not the empty f64 sum's -0.
+#[test]
+fn nothing_recombined_prints_quality_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n\
+                $EndNodes\n$Elements\n1\n1 2 2 0 1 1 2 3\n$EndElements\n";
+    std::fs::write(dir.path().join("one.msh"), text).unwrap();
+    for args in [
+        &["recombine", "one.msh", "--algo", "greedy", "--json"][..],
+        &["recombine", "one.msh", "--algo", "greedy"][..],
+        &["optimum", "one.msh", "--json"][..],
+    ] {
+        let out = run_in(dir.path(), args);
+        let s = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{args:?}");
+        assert!(!s.contains("-0.0"), "{args:?}: {s}");
+        assert!(
+            s.contains("\"quality\":0.0") || s.contains("0.0000"),
+            "{args:?}: {s}"
+        );
+    }
+}

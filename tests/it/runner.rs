@@ -421,6 +421,17 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     assert_eq!(dup.status.code(), Some(2));
     assert!(stderr(&dup).contains("is in both"), "{}", stderr(&dup));
 
+    // Shards cut with another --shard count are named as such, not as a duplicated run.
+    let args = sweep_args(&mesh, "r3", 3, "1..2");
+    assert!(sweep(dir, &args, &["--shard", "2/3"]).status.success());
+    let counts = run_in(dir, &["merge", "p1", "r3", "--out", "m6", "--no-report"]);
+    assert_eq!(counts.status.code(), Some(2));
+    assert!(
+        stderr(&counts).contains("is shard 1/2 but") && stderr(&counts).contains("shard 2/3"),
+        "{}",
+        stderr(&counts)
+    );
+
     let nodir = run_in(dir, &["merge", "p1", "nodir", "--out", "m5", "--no-report"]);
     assert_eq!(nodir.status.code(), Some(2));
     assert!(
