@@ -135,13 +135,5 @@ fn check_output(path: &Path) -> Result<(), BadInput> {
             path.display()
         )));
     }
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
-    if let Some(dir) = dir.filter(|d| !d.is_dir()) {
-        return Err(BadInput(format!(
-            "{}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        )));
-    }
-    Ok(())
+    super::check_output_place(path)
 }

@@ -92,27 +92,29 @@ pub fn describe(err: &anyhow::Error) -> String {
 /// Checks before any work that an output path names a `.msh` or `.vtu` file (any case) in
 /// a directory that exists, so that a long run does not end on a path it cannot write.
 pub fn check_mesh_output(path: Option<&std::path::Path>) -> Result<(), BadInput> {
-    let Some(p) = path else {
-        return Ok(());
-    };
-    if output_kind(p).is_none() {
-        return Err(BadInput(format!(
+    match path {
+        Some(p) if output_kind(p).is_none() => Err(BadInput(format!(
             "output {}: expected a .msh or .vtu file name",
             p.display()
-        )));
+        ))),
+        Some(p) => check_output_place(p),
+        None => Ok(()),
     }
-    if p.is_dir() {
-        return Err(BadInput(format!("output {}: is a directory", p.display())));
+}
+
+/// The part of [`check_mesh_output`] that does not look at the extension: `path` names a
+/// file (not a directory, no trailing slash) whose directory exists.
+pub fn check_output_place(p: &std::path::Path) -> Result<(), BadInput> {
+    let bad = |why: String| Err(BadInput(format!("output {}: {why}", p.display())));
+    if p.is_dir() || p.as_os_str().to_string_lossy().ends_with('/') {
+        return bad("names a directory, not a file".into());
     }
     let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
-    if let Some(dir) = dir.filter(|d| !d.is_dir()) {
-        return Err(BadInput(format!(
-            "output {}: directory {} does not exist",
-            p.display(),
-            dir.display()
-        )));
+    match dir {
+        Some(d) if d.exists() && !d.is_dir() => bad(format!("{} is not a directory", d.display())),
+        Some(d) if !d.exists() => bad(format!("directory {} does not exist", d.display())),
+        _ => Ok(()),
     }
-    Ok(())
 }
 
 /// `Some(true)` for a `.vtu` path, `Some(false)` for `.msh`, `None` otherwise (any case).
@@ -137,8 +139,14 @@ pub fn write_mesh_output(
 ) -> Result<(), BadInput> {
     use std::io::Write;
     let fail = |e: &dyn std::fmt::Display| {
-        BadInput(format!("cannot write output {}: {e}", path.display()))
+        BadInput(format!(
+            "cannot write output {} (through a temporary file beside it): {e}",
+            path.display()
+        ))
     };
+    // Through a symbolic link: replace the file it points to, not the link.
+    let resolved = std::fs::canonicalize(path).ok();
+    let path = resolved.as_deref().unwrap_or(path);
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(format!(".tmp-{}", std::process::id()));
     let tmp = std::path::PathBuf::from(tmp);
@@ -150,6 +158,13 @@ pub fn write_mesh_output(
             quadrecomb::mesh::msh::write_to(&mut w, mesh, rec)?;
         }
         w.flush()?;
+        let file = w.into_inner().map_err(|e| e.into_error())?;
+        // An existing file keeps its permissions; the data reaches the disk before the
+        // rename makes it the file.
+        if let Ok(meta) = std::fs::metadata(path) {
+            file.set_permissions(meta.permissions())?;
+        }
+        file.sync_all()?;
         std::fs::rename(&tmp, path)
     })();
     written.map_err(|e| {

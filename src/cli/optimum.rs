@@ -9,9 +9,9 @@ use std::process::ExitCode;
 pub struct Args {
     /// Mesh file (.msh) or built-in name.
     mesh: String,
-    /// Print one JSON object: the fields of `recombine --json` that apply (algo "optimum";
-    /// horizon, seed, nodes_expanded and trees null; no quality_pct), plus `check` with
-    /// --check.
+    /// Print one JSON object: mesh, triangles, algo ("optimum"), horizon, seed,
+    /// nodes_expanded and trees (null), quads, triangles_left, recombined_pct, quality and
+    /// time_s as `recombine --json` has them, plus `check` with --check.
     #[arg(long)]
     json: bool,
     /// Also verify the dual certificate of the matching (feasible duals, complementary

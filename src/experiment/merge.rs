@@ -32,10 +32,12 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     let mut manifests = Vec::new();
     for p in parts {
         if !p.is_dir() {
-            return Err(ExperimentError::Merge(format!(
-                "{}: no such results directory",
-                p.display()
-            )));
+            let why = if p.exists() {
+                "not a directory (give a sweep's results directory)"
+            } else {
+                "no such results directory"
+            };
+            return Err(ExperimentError::Merge(format!("{}: {why}", p.display())));
         }
         if !p.join(MANIFEST_FILE).is_file() {
             return Err(ExperimentError::Merge(format!(

@@ -107,12 +107,13 @@ impl SweepConfig {
                 return bad("--runs must be at least 1".into());
             }
         }
-        if self.baseline_runs == 0 && self.algos.iter().any(|a| !has_horizon(a)) {
+        let baseline = |a: &&String| a.as_str() == "greedy" || a.as_str() == "greedy-nocrit";
+        if self.baseline_runs == 0 && self.algos.iter().any(|a| baseline(&a)) {
             return bad(format!(
                 "--baseline-runs must be at least 1 (it is the number of runs of {})",
                 self.algos
                     .iter()
-                    .filter(|a| !has_horizon(a))
+                    .filter(baseline)
                     .cloned()
                     .collect::<Vec<_>>()
                     .join(", ")

@@ -105,26 +105,42 @@ fn prepare(results: &Results, run: &Run) -> Result<Prepared, String> {
     let manifest = results.manifest.as_ref();
     let entry = manifest.and_then(|m| m.spec.meshes.iter().find(|e| e.name == run.mesh));
     let source = entry.map_or(run.mesh.clone(), |e| e.source.clone());
-    // The source as given (from this working directory), then the absolute path the sweep
-    // recorded, then the source relative to the results directory.
-    let mut tries = vec![source.clone()];
-    tries.extend(entry.and_then(|e| e.path.clone()));
-    tries.push(results.dir.join(&source).to_string_lossy().into_owned());
-    let mut loaded = crate::mesh::load(&tries[0]);
-    for alt in &tries[1..] {
-        if loaded.is_err() && std::path::Path::new(alt).is_file() {
-            loaded = crate::mesh::load(alt);
+    // Where the mesh may be: the source as given (from this working directory), the absolute
+    // path the sweep recorded, the source relative to the results directory, and the built-in
+    // of that name. The first that loads with the recorded hash is used.
+    let mut tries: Vec<Result<crate::mesh::Mesh, String>> = Vec::new();
+    let load = |spec: &str| crate::mesh::load(spec).map_err(|e| e.to_string());
+    tries.push(load(&source));
+    if let Some(p) = entry.and_then(|e| e.path.as_deref()) {
+        tries.push(load(p));
+    }
+    let beside = results.dir.join(&source);
+    if beside.is_file() {
+        tries.push(load(&beside.to_string_lossy()));
+    }
+    if let Some(bytes) = crate::mesh::builtin::bytes(&source) {
+        let src = crate::mesh::Source {
+            path: source.clone().into(),
+            builtin: true,
+            bytes: bytes.into(),
+        };
+        tries.push(src.mesh().map_err(|e| e.to_string()));
+    }
+    let matches = |m: &crate::mesh::Mesh| run.mesh_hash.is_empty() || mesh_hash(m) == run.mesh_hash;
+    let first_err = tries[0].as_ref().err().cloned().unwrap_or_default();
+    let mesh = match tries.iter().position(|t| t.as_ref().is_ok_and(matches)) {
+        Some(i) => tries.swap_remove(i).expect("checked"),
+        None => {
+            return Err(match tries.into_iter().find_map(Result::ok) {
+                Some(m) => format!(
+                    "mesh {source} has changed since the sweep (hash {} vs recorded {})",
+                    &mesh_hash(&m)[..12],
+                    &run.mesh_hash[..12.min(run.mesh_hash.len())]
+                ),
+                None => format!("cannot load mesh {source}: {first_err}"),
+            });
         }
-    }
-    let mesh = loaded.map_err(|e| format!("cannot load mesh {source}: {e}"))?;
-    let hash = mesh_hash(&mesh);
-    if !run.mesh_hash.is_empty() && hash != run.mesh_hash {
-        return Err(format!(
-            "mesh {source} has changed since the sweep (hash {} vs recorded {})",
-            &hash[..12.min(hash.len())],
-            &run.mesh_hash[..12.min(run.mesh_hash.len())]
-        ));
-    }
+    };
     let want = manifest
         .and_then(|m| m.optimum.iter().find(|o| o.mesh == run.mesh))
         .map(|o| o.eta_hash.clone());

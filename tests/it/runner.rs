@@ -553,6 +553,33 @@ fn sweep_refuses_arguments_it_cannot_follow() {
         assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
     }
     assert!(!dir.join("a").exists() && !dir.join("b").join("runs.jsonl").exists());
+    // The optimum runs once whatever --baseline-runs says: 0 is fine without the greedy ones.
+    let mesh = small_mesh(dir, 200);
+    let out = run_in(
+        dir,
+        &[
+            "sweep",
+            "--mesh",
+            mesh.to_str().unwrap(),
+            "--algo",
+            "selective",
+            "optimum",
+            "--horizons",
+            "1",
+            "--runs",
+            "1",
+            "--baseline-runs",
+            "0",
+            "--backend",
+            "cpu",
+            "--quiet",
+            "--no-report",
+            "--out",
+            "c",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(records(&dir.join("c")).len(), 2);
 }
 
 /// Shards run from different working directories (the mesh given by different relative
@@ -584,12 +611,18 @@ fn shards_from_other_directories_merge_and_report_finds_the_mesh() {
         report.contains("![") && !report.contains("No picture"),
         "{report}"
     );
-    // From another directory, where `small.msh` does not resolve.
-    let r = run_in(&sub, &["report", "../m"]);
-    assert!(r.status.success(), "{}", stderr(&r));
-    let report = std::fs::read_to_string(dir.join("m/report.md")).unwrap();
-    assert!(
-        report.contains("![") && !report.contains("No picture"),
-        "{report}"
-    );
+    // From another directory, where `small.msh` does not resolve, and from one where it
+    // names another mesh (the recorded path, whose hash matches, is used instead).
+    for other_mesh_there in [false, true] {
+        if other_mesh_there {
+            small_mesh(&sub, 500);
+        }
+        let r = run_in(&sub, &["report", "../m"]);
+        assert!(r.status.success(), "{}", stderr(&r));
+        let report = std::fs::read_to_string(dir.join("m/report.md")).unwrap();
+        assert!(
+            report.contains("![") && !report.contains("No picture"),
+            "{report}"
+        );
+    }
 }

@@ -479,23 +479,34 @@ fn recombine_cli_prints_json_and_writes_meshes() {
             "0",
         ][..],
         &["recombine", "sphere", "--algo", "greedy", "-o", "out.obj"][..],
-        // Output paths it could not write are refused before the search.
-        &[
-            "recombine",
-            "sphere",
-            "--algo",
-            "greedy",
-            "-o",
-            "no/such/dir/x.msh",
-        ][..],
-        &["recombine", "sphere", "--algo", "greedy", "-o", "."][..],
-        &["optimum", "sphere", "-o", "no/such/dir/x.vtu"][..],
     ] {
         let bad = crate::util::run_in(dir.path(), args);
-        let err = String::from_utf8_lossy(&bad.stderr);
-        assert_eq!(bad.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.starts_with("error: "), "{args:?}: {err}");
-        assert!(bad.stdout.is_empty(), "{args:?} ran before refusing");
+        assert_eq!(bad.status.code(), Some(2), "{args:?}");
+    }
+    // Output paths it could not write are refused by the check made before the search (its
+    // messages; a failed write after the search would say "cannot write output").
+    std::fs::create_dir(dir.path().join("adir.msh")).unwrap();
+    std::fs::write(dir.path().join("afile"), "").unwrap();
+    for (o, why) in [
+        ("no/such/dir/x.msh", "directory no/such/dir does not exist"),
+        ("adir.msh", "names a directory"),
+        ("x.msh/", "names a directory"),
+        ("afile/x.vtu", "afile is not a directory"),
+    ] {
+        for cmd in [
+            &["recombine", "sphere", "--algo", "greedy"][..],
+            &["optimum", "sphere"],
+        ] {
+            let mut args = cmd.to_vec();
+            args.extend(["-o", o]);
+            let bad = crate::util::run_in(dir.path(), &args);
+            let err = String::from_utf8_lossy(&bad.stderr);
+            assert_eq!(bad.status.code(), Some(2), "{args:?}: {err}");
+            assert!(
+                err.starts_with(&format!("error: output {o}: {why}")),
+                "{args:?}: {err}"
+            );
+        }
     }
     // Extensions in any case; the write goes through a temporary file renamed into place.
     let upper = crate::util::run_in(
@@ -521,6 +532,37 @@ fn recombine_cli_prints_json_and_writes_meshes() {
         .collect();
     assert!(names.iter().any(|n| n == "UP.MSH"), "{names:?}");
     assert!(!names.iter().any(|n| n.contains(".tmp")), "{names:?}");
+    // Through a symbolic link, the file it points to is replaced, keeping its permissions.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let target = dir.path().join("target.vtu");
+        std::fs::write(&target, "").unwrap();
+        std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o640)).unwrap();
+        std::os::unix::fs::symlink("target.vtu", dir.path().join("link.vtu")).unwrap();
+        let out = crate::util::run_in(
+            dir.path(),
+            &[
+                "recombine",
+                "sphere",
+                "--algo",
+                "greedy",
+                "-o",
+                "link.vtu",
+                "--no-optimum",
+            ],
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let link = std::fs::symlink_metadata(dir.path().join("link.vtu")).unwrap();
+        assert!(link.file_type().is_symlink());
+        let meta = std::fs::metadata(&target).unwrap();
+        assert!(meta.len() > 1000);
+        assert_eq!(meta.permissions().mode() & 0o777, 0o640);
+    }
 }
 
 /// `recombine --backend cpu` (the CPU twin's f32 eta) repeats a committed sweep's run from its
