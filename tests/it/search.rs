@@ -454,19 +454,23 @@ fn recombine_cli_prints_json_and_writes_meshes() {
     let sum = back["quad_eta"]["mean"].as_f64().unwrap() * quads as f64;
     let quality = v["quality"].as_f64().unwrap();
     assert!((sum - quality).abs() < 1e-9 * quality, "{sum} vs {quality}");
-    let vtu = crate::util::run_in(
-        dir.path(),
-        &[
-            "recombine",
-            "sphere",
-            "--algo",
-            "greedy",
-            "-o",
-            "out.vtu",
-            "--no-optimum",
-        ],
-    );
-    assert!(vtu.status.success());
+    let write_to = |o: &str| {
+        let out = crate::util::run_in(
+            dir.path(),
+            &[
+                "recombine",
+                "sphere",
+                "--algo",
+                "greedy",
+                "-o",
+                o,
+                "--no-optimum",
+            ],
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{o}: {err}");
+    };
+    write_to("out.vtu");
     assert!(dir.path().join("out.vtu").exists());
     // Bad input: zero horizon, unknown output format.
     for args in [
@@ -509,23 +513,7 @@ fn recombine_cli_prints_json_and_writes_meshes() {
         }
     }
     // Extensions in any case; the write goes through a temporary file renamed into place.
-    let upper = crate::util::run_in(
-        dir.path(),
-        &[
-            "recombine",
-            "sphere",
-            "--algo",
-            "greedy",
-            "-o",
-            "UP.MSH",
-            "--no-optimum",
-        ],
-    );
-    assert!(
-        upper.status.success(),
-        "{}",
-        String::from_utf8_lossy(&upper.stderr)
-    );
+    write_to("UP.MSH");
     let names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -540,23 +528,7 @@ fn recombine_cli_prints_json_and_writes_meshes() {
         std::fs::write(&target, "").unwrap();
         std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o640)).unwrap();
         std::os::unix::fs::symlink("target.vtu", dir.path().join("link.vtu")).unwrap();
-        let out = crate::util::run_in(
-            dir.path(),
-            &[
-                "recombine",
-                "sphere",
-                "--algo",
-                "greedy",
-                "-o",
-                "link.vtu",
-                "--no-optimum",
-            ],
-        );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        write_to("link.vtu");
         let link = std::fs::symlink_metadata(dir.path().join("link.vtu")).unwrap();
         assert!(link.file_type().is_symlink());
         let meta = std::fs::metadata(&target).unwrap();
