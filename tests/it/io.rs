@@ -1014,3 +1014,25 @@ fn nothing_recombined_prints_quality_zero() {
         );
     }
 }
+
+/// `info` gives a self-intersecting input quad (a bowtie: nodes of a square in the order
+/// 1, 3, 2, 4) eta 0, and the square itself eta 1.
+#[test]
+fn info_gives_a_bowtie_quad_eta_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    for (order, eta) in [("1 2 3 4", 1.0), ("1 3 2 4", 0.0)] {
+        let text = format!(
+            "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 1 1 0\n\
+             4 0 1 0\n$EndNodes\n$Elements\n1\n1 3 2 0 1 {order}\n$EndElements\n"
+        );
+        std::fs::write(dir.path().join("q.msh"), text).unwrap();
+        let out = run_in(dir.path(), &["info", "q.msh", "--json"]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["quad_eta"]["max"].as_f64(), Some(eta), "{order}: {v}");
+    }
+}
