@@ -64,6 +64,20 @@ pub fn quad_eta(p: [[f64; 3]; 4]) -> f64 {
     eta_from_angles([a0, a1, a2, a3])
 }
 
+/// eta of a quad given as a cycle of four corners, as a mesh file holds it: read as its two
+/// triangles either side of the diagonal from the first corner to the third (as
+/// [`quad_eta`]), and 0 when those halves face opposite ways (folded by more than 90 degrees
+/// about the diagonal, as a self-intersecting "bowtie" is). Candidates never are: their
+/// triangles are consistently oriented neighbours.
+pub fn input_quad_eta(p: [[f64; 3]; 4]) -> f64 {
+    use crate::mesh::topology::{cross, dot, sub};
+    let [a, b, c, d] = p;
+    if dot(cross(sub(c, a), sub(d, a)), cross(sub(b, a), sub(c, a))) < 0.0 {
+        return 0.0;
+    }
+    quad_eta(p)
+}
+
 /// The candidate table: one entry per pair of neighbouring triangles (dual-graph edge).
 ///
 /// Candidates are numbered in order of their lower triangle, then side. `quads[c]` lists the
@@ -137,6 +151,11 @@ impl CandidateTable {
         self.pairs.is_empty()
     }
 
+    /// Sum of eta over the candidates `chosen` (eq. 2): 0 for none (not the empty sum's -0).
+    pub fn quality_of(&self, chosen: &[u32]) -> f64 {
+        chosen.iter().map(|&c| self.eta[c as usize]).sum::<f64>() + 0.0
+    }
+
     /// The triangle paired with `t` by candidate `c`.
     #[inline]
     pub fn other(&self, c: u32, t: u32) -> u32 {
@@ -205,6 +224,21 @@ mod tests {
             [1.0, 1.0, 0.0],
         ];
         assert_eq!(quad_eta(p), 0.0);
+    }
+
+    #[test]
+    fn input_quads_that_cross_themselves_have_eta_zero() {
+        let [a, b, c, d] = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        assert_eq!(input_quad_eta([a, b, c, d]), 1.0);
+        // Corners 1, 3, 2, 4: the halves about the diagonal overlap; read as a 180-degree
+        // fold, quad_eta alone gives 0.5.
+        assert_eq!(quad_eta([a, c, b, d]), 0.5);
+        assert_eq!(input_quad_eta([a, c, b, d]), 0.0);
     }
 
     #[test]

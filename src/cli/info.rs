@@ -167,34 +167,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     print(&info, args.json)
 }
 
-/// eta of each quad (checked vertex indices), its vertices in order: the diagonal from the
-/// first to the third, as `recombine` writes them.
-/// eta of the input quads, each read as the two triangles either side of its diagonal
-/// 0–2 (as a recombined quad). A quad whose two halves face opposite ways (folded by more
-/// than 90 degrees about the diagonal: a bowtie, whose halves overlap) gets 0; a recombined
-/// quad never does, as its triangles were consistently oriented neighbours.
+/// eta of each input quad (checked vertex indices): [`quality::input_quad_eta`], whose
+/// diagonal runs from the first vertex to the third, as `recombine` writes them.
 fn quad_etas(vertices: &[[f64; 3]], quads: &[[u32; 4]]) -> Vec<f64> {
-    let sub = |p: [f64; 3], q: [f64; 3]| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
-    let cross = |u: [f64; 3], v: [f64; 3]| {
-        [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ]
-    };
-    let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
     quads
         .iter()
-        .map(|q| {
-            let [a, b, c, d] = q.map(|v| vertices[v as usize]);
-            let n1 = cross(sub(c, a), sub(d, a));
-            let n2 = cross(sub(b, a), sub(c, a));
-            if dot(n1, n2) < 0.0 {
-                0.0
-            } else {
-                quality::quad_eta([a, b, c, d])
-            }
-        })
+        .map(|q| quality::input_quad_eta(q.map(|v| vertices[v as usize])))
         .collect()
 }
 

@@ -107,16 +107,14 @@ impl SweepConfig {
                 return bad("--runs must be at least 1".into());
             }
         }
-        let baseline = |a: &&String| a.as_str() == "greedy" || a.as_str() == "greedy-nocrit";
-        if self.baseline_runs == 0 && self.algos.iter().any(|a| baseline(&a)) {
+        // `--baseline-runs` counts the greedy runs (the optimum always runs once).
+        let baselines: Vec<&str> = (self.algos.iter().map(String::as_str))
+            .filter(|a| matches!(*a, "greedy" | "greedy-nocrit"))
+            .collect();
+        if self.baseline_runs == 0 && !baselines.is_empty() {
             return bad(format!(
                 "--baseline-runs must be at least 1 (it is the number of runs of {})",
-                self.algos
-                    .iter()
-                    .filter(baseline)
-                    .cloned()
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                baselines.join(", ")
             ));
         }
         for (i, h) in self.horizons.iter().enumerate() {

@@ -7,7 +7,7 @@ pub mod generate;
 mod load;
 pub mod msh;
 pub mod order;
-mod topology;
+pub(crate) mod topology;
 pub mod vtu;
 
 pub use load::{Source, load, source};

@@ -107,38 +107,50 @@ fn prepare(results: &Results, run: &Run) -> Result<Prepared, String> {
     let source = entry.map_or(run.mesh.clone(), |e| e.source.clone());
     // Where the mesh may be: the source as given (from this working directory), the absolute
     // path the sweep recorded, the source relative to the results directory, and the built-in
-    // of that name. The first that loads with the recorded hash is used.
-    let mut tries: Vec<Result<crate::mesh::Mesh, String>> = Vec::new();
-    let load = |spec: &str| crate::mesh::load(spec).map_err(|e| e.to_string());
-    tries.push(load(&source));
-    if let Some(p) = entry.and_then(|e| e.path.as_deref()) {
-        tries.push(load(p));
-    }
+    // of that name. Loaded in that order until one has the recorded hash.
+    let mut places: Vec<String> = vec![source.clone()];
+    places.extend(entry.and_then(|e| e.path.clone()));
     let beside = results.dir.join(&source);
     if beside.is_file() {
-        tries.push(load(&beside.to_string_lossy()));
+        places.push(beside.to_string_lossy().into_owned());
     }
-    if let Some(bytes) = crate::mesh::builtin::bytes(&source) {
-        let src = crate::mesh::Source {
-            path: source.clone().into(),
-            builtin: true,
-            bytes: bytes.into(),
-        };
-        tries.push(src.mesh().map_err(|e| e.to_string()));
+    let builtin = crate::mesh::builtin::bytes(&source).map(|bytes| crate::mesh::Source {
+        path: source.clone().into(),
+        builtin: true,
+        bytes: bytes.into(),
+    });
+    let loads = (places.iter().map(|p| crate::mesh::load(p)))
+        .chain(builtin.map(|src| src.mesh()))
+        .map(|m| m.map_err(|e| e.to_string()));
+    let (mut first_err, mut other_hash) = (None, None);
+    let mut found = None;
+    for loaded in loads {
+        match loaded {
+            Ok(m) => {
+                let hash = mesh_hash(&m);
+                if run.mesh_hash.is_empty() || hash == run.mesh_hash {
+                    found = Some(m);
+                    break;
+                }
+                other_hash.get_or_insert(hash);
+            }
+            Err(e) => {
+                first_err.get_or_insert(e);
+            }
+        }
     }
-    let matches = |m: &crate::mesh::Mesh| run.mesh_hash.is_empty() || mesh_hash(m) == run.mesh_hash;
-    let first_err = tries[0].as_ref().err().cloned().unwrap_or_default();
-    let mesh = match tries.iter().position(|t| t.as_ref().is_ok_and(matches)) {
-        Some(i) => tries.swap_remove(i).expect("checked"),
-        None => {
-            return Err(match tries.into_iter().find_map(Result::ok) {
-                Some(m) => format!(
-                    "mesh {source} has changed since the sweep (hash {} vs recorded {})",
-                    &mesh_hash(&m)[..12],
-                    &run.mesh_hash[..12.min(run.mesh_hash.len())]
-                ),
-                None => format!("cannot load mesh {source}: {first_err}"),
-            });
+    let mesh = match (found, other_hash) {
+        (Some(m), _) => m,
+        (None, Some(hash)) => {
+            return Err(format!(
+                "mesh {source} has changed since the sweep (hash {} vs recorded {})",
+                &hash[..12.min(hash.len())],
+                &run.mesh_hash[..12.min(run.mesh_hash.len())]
+            ));
+        }
+        (None, None) => {
+            let why = first_err.unwrap_or_default();
+            return Err(format!("cannot load mesh {source}: {why}"));
         }
     };
     let want = manifest

@@ -236,8 +236,7 @@ impl<'a> Searcher<'a> {
         };
         let time_s = start.elapsed().as_secs_f64();
         let table = self.state.table();
-        // `+ 0.0`: an empty sum of f64 is -0.0, printed as such.
-        let quality = chosen.iter().map(|&c| table.eta[c as usize]).sum::<f64>() + 0.0;
+        let quality = table.quality_of(&chosen);
         let quads = chosen.len();
         let trees = match algo {
             Algo::Selective { .. } => self.trees,

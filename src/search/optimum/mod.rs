@@ -75,8 +75,7 @@ pub fn solve_certified(
         .collect();
     chosen.sort_unstable();
     let time_s = t0.elapsed().as_secs_f64();
-    // `+ 0.0`: an empty sum of f64 is -0.0, printed as such.
-    let quality = chosen.iter().map(|&c| table.eta[c as usize]).sum::<f64>() + 0.0;
+    let quality = table.quality_of(&chosen);
     let quads = chosen.len();
     let report = check.then(|| m.check(&g));
     (
