@@ -39,6 +39,8 @@ struct Info {
     candidate_pairs: usize,
     reoriented_triangles: usize,
     ignored_elements: usize,
+    /// The ignored elements per Gmsh type: "N Name (type T)", in increasing type.
+    ignored_by_type: Vec<String>,
     /// eta statistics of the candidates; absent (null) when there are none.
     eta: Option<EtaStats>,
     /// eta statistics of the input quads (a recombined mesh's quads: their mean times their
@@ -101,6 +103,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         if file.binary { "binary" } else { "ascii" }
     );
     let ignored_elements = file.ignored_elements;
+    let ignored_by_type: Vec<String> = file.skipped.iter().map(ToString::to_string).collect();
     if file.data.triangles.is_empty() && !file.data.quads.is_empty() {
         // Quads only (a fully recombined mesh, say): nothing to recombine, but its size and
         // quad quality are worth reporting, once its elements are checked as any mesh's.
@@ -123,6 +126,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             candidate_pairs: 0,
             reoriented_triangles: 0,
             ignored_elements,
+            ignored_by_type,
             eta: None,
             quad_eta: eta_stats(&quad_etas(&data.vertices, &data.quads)),
             time_ms: Times {
@@ -155,6 +159,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         candidate_pairs: table.len(),
         reoriented_triangles: m.reoriented,
         ignored_elements,
+        ignored_by_type,
         eta: eta_stats(&table.eta),
         quad_eta: eta_stats(&quad_etas(&m.vertices, &m.quads)),
         time_ms: Times {
@@ -209,8 +214,9 @@ fn text(i: &Info) -> String {
     if i.ignored_elements > 0 {
         wln!(
             s,
-            "ignored elements:     {} (points, lines and other types)",
-            i.ignored_elements
+            "ignored elements:     {} ({})",
+            i.ignored_elements,
+            i.ignored_by_type.join(", ")
         );
     }
     match &i.eta {

@@ -14,6 +14,10 @@ pub enum MeshError {
     #[error("the mesh has no triangles (nothing to recombine)")]
     NoTriangles,
     #[error(
+        "the mesh has no 3-node triangles to recombine: its surface elements are {skipped}, which are not read (only first-order triangles and quads are; make the mesh first order, e.g. gmsh.model.mesh.setOrder(1) before writing it, or Gmsh's -order 1 option)"
+    )]
+    OnlySkippedSurfaceElements { skipped: String },
+    #[error(
         "the mesh is too large: {vertices} vertices, {triangles} triangles (at most 2^32 - 2 each)"
     )]
     TooLarge { vertices: usize, triangles: usize },
@@ -25,6 +29,10 @@ pub enum MeshError {
     RepeatedNode { element: u64, node: u64 },
     #[error("triangle {element} is degenerate (zero area): nodes {nodes:?}")]
     DegenerateTriangle { element: u64, nodes: [u64; 3] },
+    #[error(
+        "element tag {tag} is given to two elements (tags must be unique: Gmsh would keep only the last one)"
+    )]
+    DuplicateElementTag { tag: u64 },
     #[error("triangle {element} duplicates triangle {first} (same three nodes)")]
     DuplicateTriangle { element: u64, first: u64 },
     #[error(

@@ -110,6 +110,9 @@ impl MeshData {
                 }
             }
         }
+        if let Some(tag) = repeated(self.triangle_ids.iter().chain(&self.quad_ids).copied()) {
+            return Err(MeshError::DuplicateElementTag { tag });
+        }
         Ok(())
     }
 
@@ -195,6 +198,21 @@ impl Recombined {
             ..Recombined::default()
         }
     }
+}
+
+/// The smallest value that occurs more than once, if any (one pass when the values
+/// increase, as files usually number their elements).
+fn repeated(values: impl Iterator<Item = u64> + Clone) -> Option<u64> {
+    let mut last = None;
+    if values
+        .clone()
+        .all(|v| last.replace(v).is_none_or(|l| l < v))
+    {
+        return None;
+    }
+    let mut v: Vec<u64> = values.collect();
+    v.sort_unstable();
+    v.windows(2).find(|w| w[0] == w[1]).map(|w| w[0])
 }
 
 /// Distinct tags of `a` and `b`, sorted.

@@ -37,6 +37,40 @@ impl Topology {
     }
 }
 
+/// The error for a mesh with non-manifold edges, the same whatever the order of the nodes
+/// and elements (the file's, or the spatial order of a loaded mesh): the edge with the
+/// smallest node tags, its nodes in increasing tag, its first elements in increasing tag.
+/// `half`: sorted half-edges `(a, b, element, ...)` as in [`build`].
+fn non_manifold<T>(
+    half: &[(u32, u32, u32, T)],
+    vertex_ids: &[u64],
+    element_id: impl Fn(u32) -> u64,
+) -> MeshError {
+    let mut worst: Option<(u64, u64, Vec<u64>)> = None;
+    for group in half.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        if group.len() <= 2 {
+            continue;
+        }
+        let (ta, tb) = (
+            vertex_ids[group[0].0 as usize],
+            vertex_ids[group[0].1 as usize],
+        );
+        let key = (ta.min(tb), ta.max(tb));
+        if worst.as_ref().is_none_or(|w| key < (w.0, w.1)) {
+            let mut elements: Vec<u64> = group.iter().map(|h| element_id(h.2)).collect();
+            elements.sort_unstable();
+            worst = Some((key.0, key.1, elements));
+        }
+    }
+    let (a, b, elements) = worst.expect("a non-manifold edge");
+    MeshError::NonManifoldEdge {
+        a,
+        b,
+        count: elements.len(),
+        elements: elements.into_iter().take(4).collect(),
+    }
+}
+
 /// Validates `data` and builds the mesh with its topology.
 pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
     let nv = data.vertices.len();
@@ -134,12 +168,7 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
         }
         let group = &half[i..j];
         if group.len() > 2 {
-            return Err(MeshError::NonManifoldEdge {
-                a: data.vertex_ids[a as usize],
-                b: data.vertex_ids[b as usize],
-                count: group.len(),
-                elements: group.iter().take(4).map(|h| element_id(h.2)).collect(),
-            });
+            return Err(non_manifold(&half, &data.vertex_ids, element_id));
         }
         let e = edges.len() as u32;
         edges.push([a, b]);
@@ -380,6 +409,37 @@ mod tests {
         mesh.sanity_check().unwrap();
         assert_eq!(mesh.topology.num_dual_edges(), 0);
         assert_eq!(mesh.topology.component_sizes, vec![1, 1]);
+    }
+
+    /// The message names the same edge and elements whatever the order of the nodes and
+    /// triangles (`info` reads the file's order, the other commands a spatial order).
+    #[test]
+    fn non_manifold_error_does_not_depend_on_the_order() {
+        // Fins on a square: edges 1-3 (node ids) and 3-4 each in three triangles.
+        let mut data = square([0, 2, 3]);
+        data.vertices.push([1.0, 1.0, 1.0]);
+        data.vertices.push([0.0, 1.0, 1.0]);
+        data.triangles.push([0, 2, 4]);
+        data.triangles.push([2, 3, 5]);
+        data.triangles.push([2, 3, 4]);
+        data.vertex_ids = vec![1, 2, 3, 4, 5, 6];
+        data.triangle_ids = vec![10, 11, 12, 13, 14];
+        data.triangle_surface = vec![1; 5];
+        let want = Mesh::new(data.clone()).unwrap_err();
+        assert!(
+            matches!(&want, MeshError::NonManifoldEdge { a: 1, b: 3, count: 3, elements } if elements == &[10, 11, 12]),
+            "{want}"
+        );
+        // Nodes and triangles in reverse order.
+        let n = data.vertices.len() as u32;
+        data.vertices.reverse();
+        data.vertex_ids.reverse();
+        for t in &mut data.triangles {
+            *t = t.map(|v| n - 1 - v);
+        }
+        data.triangles.reverse();
+        data.triangle_ids.reverse();
+        assert_eq!(Mesh::new(data).unwrap_err(), want);
     }
 
     #[test]

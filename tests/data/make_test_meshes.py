@@ -49,3 +49,38 @@ gmsh.write("param_41_ascii.msh")
 gmsh.option.setNumber("Mesh.Binary", 1)
 gmsh.write("param_41_bin.msh")
 gmsh.finalize()
+
+# A mesh split into two partitions (MSH 4.1 puts each partition's elements on new entities,
+# listed with their parent surface in $PartitionedEntities; 2.2 keeps the elementary tag).
+gmsh.initialize()
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.model.add("parts")
+gmsh.model.occ.addRectangle(0, 0, 0, 1, 1)
+gmsh.model.occ.synchronize()
+gmsh.option.setNumber("Mesh.MeshSizeMin", 0.3)
+gmsh.option.setNumber("Mesh.MeshSizeMax", 0.3)
+gmsh.model.mesh.generate(2)
+gmsh.option.setNumber("Mesh.PartitionCreateTopology", 1)
+gmsh.option.setNumber("Mesh.PartitionCreateGhostCells", 1)
+gmsh.model.mesh.partition(2)
+for version, binary in ((4.1, 0), (4.1, 1), (2.2, 0)):
+    gmsh.option.setNumber("Mesh.MshFileVersion", version)
+    gmsh.option.setNumber("Mesh.Binary", binary)
+    name = f"parts_{str(version).replace('.', '')}_{'bin' if binary else 'ascii'}.msh"
+    gmsh.write(name)
+gmsh.finalize()
+
+# Second-order triangles only (6 nodes, type 9): nothing the reader recombines.
+gmsh.initialize()
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.model.add("order2")
+gmsh.model.occ.addRectangle(0, 0, 0, 1, 1)
+gmsh.model.occ.synchronize()
+gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5)
+gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
+gmsh.model.mesh.generate(2)
+gmsh.model.mesh.setOrder(2)
+gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+gmsh.option.setNumber("Mesh.Binary", 0)
+gmsh.write("order2_41_ascii.msh")
+gmsh.finalize()

@@ -1036,3 +1036,248 @@ fn info_gives_a_bowtie_quad_eta_zero() {
         assert_eq!(v["quad_eta"]["max"].as_f64(), Some(eta), "{order}: {v}");
     }
 }
+
+/// The reader's element types are Gmsh's: every number 1..300 has the same node count,
+/// dimension and name as `gmsh.model.mesh.getElementProperties` gives, or is unknown to both.
+#[test]
+fn element_types_are_gmsh_s() {
+    if !gmsh_available() {
+        return;
+    }
+    let script = r#"
+import gmsh
+gmsh.initialize(["-noenv"])
+gmsh.option.setNumber("General.Terminal", 0)
+for t in range(1, 301):
+    try:
+        name, dim, order, n, _, _ = gmsh.model.mesh.getElementProperties(t)
+        print(f"{t}|{n}|{dim}|{name}")
+    except Exception:
+        print(f"{t}|none")
+gmsh.finalize()
+"#;
+    let out = Command::new("python3")
+        .args(["-c", script])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut known = 0;
+    for line in text.lines() {
+        let f: Vec<&str> = line.split('|').collect();
+        let t: i64 = f[0].parse().unwrap();
+        let ours = msh::element_type(t);
+        if f[1] == "none" {
+            assert_eq!(ours, None, "type {t}: unknown to Gmsh");
+        } else {
+            let gmsh = (f[1].parse().unwrap(), f[2].parse().unwrap(), f[3]);
+            assert_eq!(ours, Some(gmsh), "type {t}");
+            known += 1;
+        }
+    }
+    assert!(known > 100, "Gmsh listed {known} types");
+}
+
+/// The error (its text) that reading `text` as MSH gives.
+fn msh_error(text: &str) -> String {
+    match msh::read_bytes("t.msh", text.as_bytes()) {
+        Ok(_) => panic!("read without error"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// `text` with line `n` (1-based) replaced by `f(line)`.
+fn edit_line(text: &str, n: usize, f: impl Fn(&str) -> String) -> String {
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    lines[n - 1] = f(&lines[n - 1]);
+    lines.join("\n") + "\n"
+}
+
+/// Each node and element is on a line of its own (as Gmsh writes them): a value too many or
+/// too few on a line is an error at that line, not a shift of every later read (a stray
+/// value once made the next element's tag and dropped a triangle without a word).
+#[test]
+fn ascii_entries_are_read_line_by_line() {
+    let v22 = std::fs::read_to_string(data("two_squares_22_ascii.msh")).unwrap();
+    let v41 = std::fs::read_to_string(data("two_squares_41_ascii.msh")).unwrap();
+    // Line 80 of the 2.2 file is triangle 41 ("41 2 2 0 2 ..."); line 6 is node 1.
+    assert!(v22.lines().nth(79).unwrap().starts_with("41 2 "));
+    let e = msh_error(&edit_line(&v22, 80, |l| format!("{l} 999")));
+    assert!(
+        e.contains("t.msh:80: unexpected `999` after the 3 nodes of element 41"),
+        "{e}"
+    );
+    let e = msh_error(&edit_line(&v22, 80, |l| {
+        l.rsplit_once(' ').unwrap().0.into()
+    }));
+    assert!(
+        e.contains("t.msh:80: the line ends where node 3 of element 41 was expected"),
+        "{e}"
+    );
+    let e = msh_error(&edit_line(&v22, 6, |l| format!("{l} 7")));
+    assert!(
+        e.contains("t.msh:6: unexpected `7` after the coordinates of node 1"),
+        "{e}"
+    );
+    // A type Gmsh does not know cannot be skipped safely.
+    let e = msh_error(&edit_line(&v22, 80, |l| l.replacen("41 2 ", "41 9999 ", 1)));
+    assert!(
+        e.contains("t.msh:80: element 41 has type 9999, which is not a Gmsh element type"),
+        "{e}"
+    );
+    // MSH 4.1: an element line and a block header.
+    let (n, line) = v41
+        .lines()
+        .enumerate()
+        .skip_while(|(_, l)| *l != "$Elements")
+        .find(|(_, l)| l.split_whitespace().count() == 4 && l.starts_with("2 "))
+        .map(|(i, l)| (i + 1, l.to_string()))
+        .unwrap();
+    let first = v41
+        .lines()
+        .nth(n)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .to_string();
+    let e = msh_error(&edit_line(&v41, n + 1, |l| format!("{l} 999")));
+    assert!(
+        e.contains(&format!(
+            "t.msh:{}: unexpected `999` after the 3 nodes of element {first}",
+            n + 1
+        )),
+        "{e}"
+    );
+    let e = msh_error(&edit_line(&v41, n, |_| line.replacen(" 2 ", " 9999 ", 1)));
+    assert!(e.contains(&format!("t.msh:{n}: element block")), "{e}");
+    assert!(
+        e.contains("type 9999, which is not a Gmsh element type"),
+        "{e}"
+    );
+}
+
+/// An MSH 2.2 element without an elementary tag is on entity 0, as Gmsh reads it, not on
+/// surface 1 (where it would join another surface's triangles).
+#[test]
+fn elements_without_elementary_tag_are_on_entity_0() {
+    let v22 = std::fs::read_to_string(data("two_squares_22_ascii.msh")).unwrap();
+    let line = v22.lines().nth(79).unwrap();
+    let f: Vec<&str> = line.split(' ').collect();
+    assert_eq!(f[2], "2", "{line}");
+    let no_tags = format!("{} {} 0 {}", f[0], f[1], f[5..].join(" "));
+    let one_tag = format!("{} {} 1 {} {}", f[0], f[1], f[3], f[5..].join(" "));
+    for edited in [no_tags, one_tag] {
+        let m =
+            msh::read_bytes("t.msh", edit_line(&v22, 80, |_| edited.clone()).as_bytes()).unwrap();
+        assert_eq!(m.surfaces(), vec![0, 1, 2], "{edited}");
+        let t = m.triangle_ids.iter().position(|&id| id == 41).unwrap();
+        assert_eq!(m.triangle_surface[t], 0);
+    }
+}
+
+/// Two elements with one tag: an error naming the tag (Gmsh would keep the last one, and
+/// every message names elements by tag), in both versions.
+#[test]
+fn duplicate_element_tags_are_refused() {
+    let v22 = std::fs::read_to_string(data("two_squares_22_ascii.msh")).unwrap();
+    let e = msh_error(&edit_line(&v22, 80, |l| l.replacen("41 ", "40 ", 1)));
+    assert!(
+        e.contains("t.msh: element tag 40 is given to two elements"),
+        "{e}"
+    );
+    let v41 = std::fs::read_to_string(data("two_squares_41_ascii.msh")).unwrap();
+    let last = v41.lines().position(|l| l == "$EndElements").unwrap();
+    let prev = v41
+        .lines()
+        .nth(last - 2)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .to_string();
+    let e = msh_error(&edit_line(&v41, last, |l| {
+        let rest = l.split_once(' ').unwrap().1;
+        format!("{prev} {rest}")
+    }));
+    assert!(
+        e.contains(&format!("element tag {prev} is given to two elements")),
+        "{e}"
+    );
+    // In memory too.
+    let mut data = mesh::MeshData {
+        vertices: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ],
+        triangles: vec![[0, 1, 2], [1, 3, 2]],
+        ..Default::default()
+    };
+    data.triangle_ids = vec![7, 7];
+    assert_eq!(
+        Mesh::new(data).unwrap_err(),
+        MeshError::DuplicateElementTag { tag: 7 }
+    );
+}
+
+/// A partitioned mesh (Gmsh's `partition`): MSH 4.1 puts each partition's triangles on an
+/// entity of its own; they are read back on their parent surface, so the mesh is the one
+/// surface the 2.2 file (which keeps elementary tags) gives, in both encodings.
+#[test]
+fn partitioned_meshes_keep_their_model_surfaces() {
+    let a22 = read("parts_22_ascii.msh");
+    assert_eq!(a22.surfaces(), vec![1]);
+    // Gmsh numbers the nodes differently in the two versions: compare triangles by their
+    // corners' coordinates (to 12 digits).
+    let key = |m: &Mesh| -> BTreeSet<Vec<String>> {
+        (0..m.num_triangles() as u32)
+            .map(|t| {
+                let mut c: Vec<String> = m
+                    .triangle_points(t)
+                    .iter()
+                    .map(|p| format!("{:.12} {:.12} {:.12}", p[0], p[1], p[2]))
+                    .collect();
+                c.sort();
+                c
+            })
+            .collect()
+    };
+    for name in ["parts_41_ascii.msh", "parts_41_bin.msh"] {
+        let m = read(name);
+        assert_eq!(m.surfaces(), vec![1], "{name}");
+        assert_eq!(m.topology.component_sizes.len(), 1, "{name}");
+        assert_eq!(m.num_triangles(), a22.num_triangles(), "{name}");
+        assert_eq!(key(&m), key(&a22), "{name}");
+    }
+}
+
+/// Second-order elements are skipped; a mesh of nothing else says what it holds and how to
+/// make it first order, and `info` lists skipped elements by type.
+#[test]
+fn second_order_meshes_say_what_was_skipped() {
+    let e = msh::read(&data("order2_41_ascii.msh"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the mesh has no 3-node triangles to recombine"),
+        "{e}"
+    );
+    assert!(e.contains("Triangle 6 (type 9)"), "{e}");
+    assert!(e.contains("setOrder(1)"), "{e}");
+    let dir = tempfile::tempdir().unwrap();
+    let out = run_in(
+        dir.path(),
+        &["info", data("two_squares_41_ascii.msh").to_str().unwrap()],
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("(") && text.contains("Line 2 (type 1)") && text.contains("Point (type 15)"),
+        "{text}"
+    );
+}

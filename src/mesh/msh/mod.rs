@@ -17,7 +17,7 @@
 mod read;
 mod write;
 
-use super::{Mesh, MeshData, ReadError, Recombined};
+use super::{Mesh, MeshData, MeshError, ReadError, Recombined};
 use std::fmt;
 use std::path::Path;
 
@@ -53,16 +53,60 @@ pub struct MshFile {
     pub binary: bool,
     /// Elements of other types (points, lines, volumes, high order) that were skipped.
     pub ignored_elements: usize,
+    /// The same, per Gmsh element type (in increasing type number).
+    pub skipped: Vec<SkippedElements>,
+}
+
+/// Elements of one Gmsh type that a reader skipped.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SkippedElements {
+    /// Gmsh's element type number.
+    pub gmsh_type: i64,
+    /// Gmsh's name of the type ("Triangle 6", "Line 2", ...).
+    pub name: &'static str,
+    /// Dimension of the type (2: surface elements).
+    pub dim: u8,
+    /// How many were skipped.
+    pub count: usize,
+}
+
+impl fmt::Display for SkippedElements {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} {} (type {})", self.count, self.name, self.gmsh_type)
+    }
 }
 
 impl MshFile {
     /// Validates the content into a [`Mesh`] (see [`Mesh::new`]); errors name `path`.
+    /// A file whose only surface elements are of higher order (or otherwise not read)
+    /// says so, rather than that it has no triangles.
     pub fn into_mesh(self, path: &Path) -> Result<Mesh, ReadError> {
+        let surface: Vec<String> = self
+            .skipped
+            .iter()
+            .filter(|k| k.dim == 2)
+            .map(ToString::to_string)
+            .collect();
+        let no_triangles = self.data.triangles.is_empty();
         Mesh::new(self.data).map_err(|source| ReadError::Mesh {
             path: path.to_path_buf(),
-            source,
+            source: match source {
+                MeshError::NoTriangles if no_triangles && !surface.is_empty() => {
+                    MeshError::OnlySkippedSurfaceElements {
+                        skipped: surface.join(", "),
+                    }
+                }
+                e => e,
+            },
         })
     }
+}
+
+/// Gmsh element type `t`: its number of nodes (0 for types without a fixed number, such as
+/// polygons), dimension and Gmsh's name; `None` for a number Gmsh does not know. Elements
+/// of every known type other than 2 (triangle) and 3 (quad) are skipped and counted.
+pub fn element_type(t: i64) -> Option<(usize, u8, &'static str)> {
+    read::element_type(t)
 }
 
 /// True when `bytes` look like a MSH file (they start with `$MeshFormat`).

@@ -5,50 +5,141 @@
 //! their header carry the byte offset (as [`ReadError::Io`] of kind `InvalidData`, whose
 //! message names the offset).
 
-use super::{MshFile, MshVersion};
+use super::{MshFile, MshVersion, SkippedElements};
 use crate::mesh::{MeshData, ReadError};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
-/// Number of nodes of each Gmsh element type (the ones Gmsh writes; 0 = unknown type).
-fn nodes_per_element(etype: i64) -> Option<usize> {
-    let n = match etype {
-        1 => 2,
-        2 => 3,
-        3 => 4,
-        4 => 4,
-        5 => 8,
-        6 => 6,
-        7 => 5,
-        8 => 3,
-        9 => 6,
-        10 => 9,
-        11 => 10,
-        12 => 27,
-        13 => 18,
-        14 => 14,
-        15 => 1,
-        16 => 8,
-        17 => 20,
-        18 => 15,
-        19 => 13,
-        20 => 9,
-        21 => 10,
-        22 => 12,
-        23 => 15,
-        24 => 15,
-        25 => 21,
-        26 => 4,
-        27 => 5,
-        28 => 6,
-        29 => 20,
-        30 => 35,
-        31 => 56,
-        92 => 64,
-        93 => 125,
-        _ => return None,
-    };
-    Some(n)
+/// Gmsh's element types (4.15, as `gmsh.model.mesh.getElementProperties` gives them; a test
+/// checks the table against it): number, nodes (0: no fixed number, polygons and the like),
+/// dimension, name. Sorted by number.
+#[rustfmt::skip]
+const ELEMENT_TYPES: [(i64, usize, u8, &str); 117] = [
+    (1, 2, 1, "Line 2"),
+    (2, 3, 2, "Triangle 3"),
+    (3, 4, 2, "Quadrilateral 4"),
+    (4, 4, 3, "Tetrahedron 4"),
+    (5, 8, 3, "Hexahedron 8"),
+    (6, 6, 3, "Prism 6"),
+    (7, 5, 3, "Pyramid 5"),
+    (8, 3, 1, "Line 3"),
+    (9, 6, 2, "Triangle 6"),
+    (10, 9, 2, "Quadrilateral 9"),
+    (11, 10, 3, "Tetrahedron 10"),
+    (12, 27, 3, "Hexahedron 27"),
+    (13, 18, 3, "Prism 18"),
+    (14, 14, 3, "Pyramid 14"),
+    (15, 1, 0, "Point"),
+    (16, 8, 2, "Quadrilateral 8"),
+    (17, 20, 3, "Hexahedron 20"),
+    (18, 15, 3, "Prism 15"),
+    (19, 13, 3, "Pyramid 13"),
+    (20, 9, 2, "Triangle 9"),
+    (21, 10, 2, "Triangle 10"),
+    (22, 12, 2, "Triangle 12"),
+    (23, 15, 2, "Triangle 15"),
+    (24, 15, 2, "Triangle 15I"),
+    (25, 21, 2, "Triangle 21"),
+    (26, 4, 1, "Line 4"),
+    (27, 5, 1, "Line 5"),
+    (28, 6, 1, "Line 6"),
+    (29, 20, 3, "Tetrahedron 20"),
+    (30, 35, 3, "Tetrahedron 35"),
+    (31, 56, 3, "Tetrahedron 56"),
+    (32, 22, 3, "Tetrahedron 22"),
+    (33, 28, 3, "Tetrahedron 28"),
+    (34, 0, 2, "Polygon"),
+    (35, 0, 3, "Polyhedron"),
+    (36, 16, 2, "Quadrilateral 16"),
+    (37, 25, 2, "Quadrilateral 25"),
+    (38, 36, 2, "Quadrilateral 36"),
+    (39, 12, 2, "Quadrilateral 12"),
+    (40, 16, 2, "Quadrilateral 16I"),
+    (41, 20, 2, "Quadrilateral 20"),
+    (42, 28, 2, "Triangle 28"),
+    (43, 36, 2, "Triangle 36"),
+    (44, 45, 2, "Triangle 45"),
+    (45, 55, 2, "Triangle 55"),
+    (46, 66, 2, "Triangle 66"),
+    (47, 49, 2, "Quadrilateral 49"),
+    (48, 64, 2, "Quadrilateral 64"),
+    (49, 81, 2, "Quadrilateral 81"),
+    (50, 100, 2, "Quadrilateral 100"),
+    (51, 121, 2, "Quadrilateral 121"),
+    (52, 18, 2, "Triangle 18"),
+    (53, 21, 2, "Triangle 21I"),
+    (54, 24, 2, "Triangle 24"),
+    (55, 27, 2, "Triangle 27"),
+    (56, 30, 2, "Triangle 30"),
+    (57, 24, 2, "Quadrilateral 24"),
+    (58, 28, 2, "Quadrilateral 28"),
+    (59, 32, 2, "Quadrilateral 32"),
+    (60, 36, 2, "Quadrilateral 36I"),
+    (61, 40, 2, "Quadrilateral 40"),
+    (62, 7, 1, "Line 7"),
+    (63, 8, 1, "Line 8"),
+    (64, 9, 1, "Line 9"),
+    (65, 10, 1, "Line 10"),
+    (66, 11, 1, "Line 11"),
+    (69, 0, 2, "Polygon Border"),
+    (71, 84, 3, "Tetrahedron 84"),
+    (72, 120, 3, "Tetrahedron 120"),
+    (73, 165, 3, "Tetrahedron 165"),
+    (74, 220, 3, "Tetrahedron 220"),
+    (75, 286, 3, "Tetrahedron 286"),
+    (79, 34, 3, "Tetrahedron 34"),
+    (80, 40, 3, "Tetrahedron 40"),
+    (81, 46, 3, "Tetrahedron 46"),
+    (82, 52, 3, "Tetrahedron 52"),
+    (83, 58, 3, "Tetrahedron 58"),
+    (84, 1, 1, "Line 1"),
+    (85, 1, 2, "Triangle 1"),
+    (86, 1, 2, "Quadrilateral 1"),
+    (87, 1, 3, "Tetrahedron 1"),
+    (88, 1, 3, "Hexahedron 1"),
+    (89, 1, 3, "Prism 1"),
+    (92, 64, 3, "Hexahedron 64"),
+    (93, 125, 3, "Hexahedron 125"),
+    (94, 216, 3, "Hexahedron 216"),
+    (95, 343, 3, "Hexahedron 343"),
+    (96, 512, 3, "Hexahedron 512"),
+    (97, 729, 3, "Hexahedron 729"),
+    (98, 1000, 3, "Hexahedron 1000"),
+    (99, 32, 3, "Hexahedron 32"),
+    (100, 44, 3, "Hexahedron 44"),
+    (101, 56, 3, "Hexahedron 56"),
+    (102, 68, 3, "Hexahedron 68"),
+    (103, 80, 3, "Hexahedron 80"),
+    (104, 92, 3, "Hexahedron 92"),
+    (105, 104, 3, "Hexahedron 104"),
+    (118, 30, 3, "Pyramid 30"),
+    (119, 55, 3, "Pyramid 55"),
+    (120, 91, 3, "Pyramid 91"),
+    (121, 140, 3, "Pyramid 140"),
+    (122, 204, 3, "Pyramid 204"),
+    (123, 285, 3, "Pyramid 285"),
+    (124, 385, 3, "Pyramid 385"),
+    (125, 21, 3, "Pyramid 21"),
+    (126, 29, 3, "Pyramid 29"),
+    (127, 37, 3, "Pyramid 37"),
+    (128, 45, 3, "Pyramid 45"),
+    (129, 53, 3, "Pyramid 53"),
+    (130, 61, 3, "Pyramid 61"),
+    (131, 69, 3, "Pyramid 69"),
+    (132, 1, 3, "Pyramid 1"),
+    (133, 0, 0, "Point Xfem"),
+    (134, 0, 1, "Line Xfem"),
+    (135, 0, 2, "Triangle Xfem"),
+    (136, 0, 3, "Tetrahedron Xfem"),
+    (137, 16, 3, "Tetrahedron 16"),
+];
+
+/// The nodes, dimension and name of Gmsh element type `etype`; `None` for a number Gmsh
+/// does not know.
+pub(super) fn element_type(etype: i64) -> Option<(usize, u8, &'static str)> {
+    let i = ELEMENT_TYPES.binary_search_by_key(&etype, |e| e.0).ok()?;
+    let (_, nodes, dim, name) = ELEMENT_TYPES[i];
+    Some((nodes, dim, name))
 }
 
 const TRIANGLE: i64 = 2;
@@ -139,6 +230,9 @@ struct Parser<'a> {
     b: &'a [u8],
     pos: usize,
     binary: bool,
+    /// Inside one entry of an ASCII section (a node, an element, a header): its values are
+    /// on one line, so tokens do not cross a line end (see [`Parser::entry_end`]).
+    in_line: bool,
 }
 
 type Res<T> = Result<T, ReadError>;
@@ -176,9 +270,46 @@ impl<'a> Parser<'a> {
     }
 
     fn skip_ws(&mut self) {
-        while self.pos < self.b.len() && self.b[self.pos].is_ascii_whitespace() {
-            self.pos += 1;
+        let b = self.b;
+        if self.in_line {
+            while self.pos < b.len() && b[self.pos].is_ascii_whitespace() && b[self.pos] != b'\n' {
+                self.pos += 1;
+            }
+        } else {
+            while self.pos < b.len() && b[self.pos].is_ascii_whitespace() {
+                self.pos += 1;
+            }
         }
+    }
+
+    /// From here to [`Parser::entry_end`], the values read are on the current line.
+    #[inline]
+    fn entry_start(&mut self) {
+        self.in_line = !self.binary;
+    }
+
+    /// Ends an entry begun with [`Parser::entry_start`]: the rest of its line must be blank
+    /// (`what` names the entry). A value left over means the line holds more than its entry
+    /// (Gmsh writes one entry per line), which would shift every later read.
+    fn entry_end(&mut self, what: &dyn Fn() -> String) -> Res<()> {
+        if !self.in_line {
+            return Ok(());
+        }
+        self.skip_ws();
+        self.in_line = false;
+        if self.pos < self.b.len() && self.b[self.pos] != b'\n' {
+            let at = self.pos;
+            let t = self.token().map_or(&b""[..], |(_, t)| t);
+            return Err(self.err(
+                at,
+                format!(
+                    "unexpected `{}` after {}: the line holds more values than it should",
+                    show(t),
+                    what()
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Next whitespace-separated token and its position, or `None` at the end of the file.
@@ -204,6 +335,13 @@ impl<'a> Parser<'a> {
     fn need(&mut self, section: &str, what: &dyn Fn() -> String) -> Res<(usize, &'a [u8])> {
         match self.token() {
             Some(t) => Ok(t),
+            None if self.pos < self.b.len() => Err(self.err(
+                self.pos,
+                format!(
+                    "the line ends where {} was expected (the values of an entry are on one line)",
+                    what()
+                ),
+            )),
             None => Err(self.err(
                 self.b.len(),
                 format!(
@@ -276,11 +414,23 @@ impl<'a> Parser<'a> {
         }
     }
 
-    /// Skips the rest of the current line (ASCII element lines of unknown types).
+    /// A `double` field: 8 little-endian bytes in a binary file, a token in an ASCII one.
+    fn double_field(&mut self, section: &str, what: &dyn Fn() -> String) -> Res<f64> {
+        if self.binary {
+            let s = self.take(8, section, what)?;
+            Ok(f64_at(s, 0))
+        } else {
+            self.float(section, what).map(|(_, v)| v)
+        }
+    }
+
+    /// Skips the rest of the current line (ASCII element lines of types without a fixed
+    /// number of nodes) and ends the entry.
     fn skip_line(&mut self) {
         while self.pos < self.b.len() && self.b[self.pos] != b'\n' {
             self.pos += 1;
         }
+        self.in_line = false;
     }
 
     /// Expects the `$End...` token closing `section`, after `count` entries.
@@ -409,7 +559,16 @@ struct Content {
     data: MeshData,
     node_tags: Vec<u64>,
     map: Option<NodeMap>,
-    ignored: usize,
+    /// Skipped elements: count per Gmsh type.
+    skipped: BTreeMap<i64, usize>,
+    /// Partitioned files (4.1): the parent surface of each partition's surface entity.
+    parents: HashMap<i64, i64>,
+}
+
+impl Content {
+    fn skip(&mut self, etype: i64, n: u64) {
+        *self.skipped.entry(etype).or_default() += n as usize;
+    }
 }
 
 /// True when `bytes` start (after whitespace and an optional UTF-8 BOM) with `$MeshFormat`.
@@ -445,6 +604,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
             0
         },
         binary: false,
+        in_line: false,
     };
     let fmt = "$MeshFormat";
     p.token(); // $MeshFormat
@@ -504,7 +664,8 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
         data: MeshData::default(),
         node_tags: Vec::new(),
         map: None,
-        ignored: 0,
+        skipped: BTreeMap::new(),
+        parents: HashMap::new(),
     };
     while let Some((start, name)) = p.token() {
         match name {
@@ -528,7 +689,10 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
                 let Some(map) = c.map.take() else {
                     return Err(p.err(start, "$Elements comes before any $Nodes section"));
                 };
-                if !c.data.triangle_ids.is_empty() || !c.data.quad_ids.is_empty() || c.ignored > 0 {
+                if !c.data.triangle_ids.is_empty()
+                    || !c.data.quad_ids.is_empty()
+                    || !c.skipped.is_empty()
+                {
                     return Err(p.err(start, "a second $Elements section"));
                 }
                 let n = match (version, p.binary) {
@@ -538,6 +702,10 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
                 };
                 p.end("$Elements", &|| format!("{n} elements"))?;
                 c.map = Some(map);
+            }
+            b"$PartitionedEntities" if version == MshVersion::V41 => {
+                partitioned41(&mut p, &mut c)?;
+                p.skip_section(start, name)?;
             }
             _ if name.first() == Some(&b'$') && !name.starts_with(b"$End") => {
                 p.skip_section(start, name)?;
@@ -550,11 +718,38 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
             }
         }
     }
+    if !c.parents.is_empty() {
+        // Elements of a partition's surface belong to the model surface it was cut from.
+        let parents = &c.parents;
+        for s in c
+            .data
+            .triangle_surface
+            .iter_mut()
+            .chain(&mut c.data.quad_surface)
+        {
+            if let Some(&parent) = parents.get(&i64::from(*s)) {
+                *s = to_i32(&p, 0, parent, "parent entity tag")?;
+            }
+        }
+    }
     Ok(MshFile {
         data: c.data,
         version,
         binary: p.binary,
-        ignored_elements: c.ignored,
+        ignored_elements: c.skipped.values().sum(),
+        skipped: c
+            .skipped
+            .into_iter()
+            .map(|(t, n)| {
+                let (_, dim, name) = element_type(t).expect("skipped types are known");
+                SkippedElements {
+                    gmsh_type: t,
+                    name,
+                    dim,
+                    count: n,
+                }
+            })
+            .collect(),
     })
 }
 
@@ -577,6 +772,57 @@ fn to_i32(p: &Parser<'_>, at: usize, v: i64, what: &str) -> Res<i32> {
     })
 }
 
+/// The `$PartitionedEntities` section of MSH 4.1 (a mesh split into partitions, whose
+/// elements are on new entities, one per partition and model entity): the parent of each
+/// partition surface, into `c.parents`. Reads up to the surfaces (points and curves are
+/// read past); the caller skips the rest.
+fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
+    let s = "$PartitionedEntities";
+    if p.binary {
+        p.newline_before_binary();
+    }
+    p.size_t(s, &|| "the number of partitions".into())?;
+    let ghosts = p.size_t(s, &|| "the number of ghost entities".into())?;
+    for _ in 0..ghosts {
+        p.int_field(s, &|| "a ghost entity tag".into())?;
+        p.int_field(s, &|| "a ghost entity's partition".into())?;
+    }
+    let counts: Vec<u64> = ["points", "curves", "surfaces", "volumes"]
+        .iter()
+        .map(|what| p.size_t(s, &|| format!("the number of partition {what}")))
+        .collect::<Res<_>>()?;
+    for (dim, &count) in counts.iter().take(3).enumerate() {
+        for i in 0..count {
+            let what = || format!("partition entity {} of dimension {dim}", i + 1);
+            let tag = p.int_field(s, &what)?;
+            let parent_dim = p.int_field(s, &what)?;
+            let parent = p.int_field(s, &what)?;
+            let parts = p.size_t(s, &what)?;
+            for _ in 0..parts {
+                p.int_field(s, &what)?;
+            }
+            // A point has its coordinates, a curve or surface its bounding box.
+            for _ in 0..if dim == 0 { 3 } else { 6 } {
+                p.double_field(s, &what)?;
+            }
+            let physicals = p.size_t(s, &what)?;
+            for _ in 0..physicals {
+                p.int_field(s, &what)?;
+            }
+            if dim > 0 {
+                let bounding = p.size_t(s, &what)?;
+                for _ in 0..bounding {
+                    p.int_field(s, &what)?;
+                }
+            }
+            if dim == 2 && parent_dim == 2 {
+                c.parents.insert(tag, parent);
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The header of an MSH 4.1 `$Nodes` or `$Elements` section (`item`: "node" or
 /// "element"): where it starts, the number of entity blocks and of items (the tag range is
 /// not used).
@@ -586,9 +832,11 @@ fn header41(p: &mut Parser<'_>, s: &str, item: &str) -> Res<(usize, u64, u64)> {
     }
     let hp = p.pos;
     let blocks = p.size_t(s, &|| "the number of entity blocks".into())?;
+    p.entry_start();
     let total = p.size_t(s, &|| format!("the number of {item}s"))?;
     p.size_t(s, &|| format!("the minimum {item} tag"))?;
     p.size_t(s, &|| format!("the maximum {item} tag"))?;
+    p.entry_end(&|| format!("the {s} header"))?;
     Ok((hp, blocks, total))
 }
 
@@ -604,10 +852,12 @@ fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     for blk in 0..blocks {
         let what_blk = || format!("the header of node block {} of {blocks}", blk + 1);
         let dim = p.int_field(s, &what_blk)?;
+        p.entry_start();
         p.int_field(s, &what_blk)?;
         let parametric = p.int_field(s, &what_blk)?;
         let bp = p.pos;
         let n = p.size_t(s, &what_blk)?;
+        p.entry_end(&what_blk)?;
         let have = c.node_tags.len() as u64;
         if n > total - have.min(total) {
             return Err(p.err(
@@ -658,6 +908,8 @@ fn node_block41_ascii(
     let s = "$Nodes";
     for i in 0..n {
         let tag = p.uint(s, &|| format!("node tag {} of block {}", i + 1, blk + 1))?;
+        p.entry_start();
+        p.entry_end(&|| format!("node tag {tag}"))?;
         c.node_tags.push(tag);
     }
     let first = c.node_tags.len() - n as usize;
@@ -665,12 +917,14 @@ fn node_block41_ascii(
         let tag = c.node_tags[first + i];
         let what = || format!("a coordinate of node {tag}");
         let (at, x) = p.float(s, &what)?;
+        p.entry_start();
         let (_, y) = p.float(s, &what)?;
         let (_, z) = p.float(s, &what)?;
         check_finite(p, at, tag, [x, y, z])?;
         for _ in 0..extra {
             p.float(s, &|| format!("a parametric coordinate of node {tag}"))?;
         }
+        p.entry_end(&|| format!("the coordinates of node {tag}"))?;
         c.data.vertices.push([x, y, z]);
     }
     Ok(())
@@ -711,9 +965,11 @@ fn nodes22_ascii(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     for i in 0..total {
         let tag = p.uint(s, &|| format!("the tag of node {} of {total}", i + 1))?;
         let what = || format!("a coordinate of node {tag}");
+        p.entry_start();
         let (at, x) = p.float(s, &what)?;
         let (_, y) = p.float(s, &what)?;
         let (_, z) = p.float(s, &what)?;
+        p.entry_end(&|| format!("the coordinates of node {tag}"))?;
         check_finite(p, at, tag, [x, y, z])?;
         c.node_tags.push(tag);
         c.data.vertices.push([x, y, z]);
@@ -783,12 +1039,14 @@ fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
     for blk in 0..blocks {
         let what_blk = || format!("the header of element block {} of {blocks}", blk + 1);
         p.int_field(s, &what_blk)?;
+        p.entry_start();
         let ep = p.pos;
         let entity = p.int_field(s, &what_blk)?;
         let tp = p.pos;
         let etype = p.int_field(s, &what_blk)?;
         let bp = p.pos;
         let n = p.size_t(s, &what_blk)?;
+        p.entry_end(&what_blk)?;
         if n > total - seen.min(total) {
             return Err(p.err(
                 bp,
@@ -799,14 +1057,30 @@ fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
             ));
         }
         let surface = to_i32(p, ep, entity, "entity tag")?;
+        let Some((nodes, _, name)) = element_type(etype) else {
+            return Err(p.err(
+                tp,
+                unknown_type(&format!("element block {}", blk + 1), etype),
+            ));
+        };
         let block = Block41 {
             index: blk,
             len: n,
             etype,
+            nodes,
             surface,
         };
         if p.binary {
-            element_block41_binary(p, c, map, &block, tp)?;
+            if nodes == 0 {
+                return Err(p.err(
+                    tp,
+                    format!(
+                        "element block {} holds elements of type {etype} ({name}), which have no fixed number of nodes: not read in binary files",
+                        blk + 1
+                    ),
+                ));
+            }
+            element_block41_binary(p, c, map, &block)?;
         } else {
             element_block41_ascii(p, c, map, &block)?;
         }
@@ -828,11 +1102,13 @@ struct Block41 {
     /// Number of elements.
     len: u64,
     etype: i64,
+    /// Nodes per element (0: no fixed number).
+    nodes: usize,
     surface: i32,
 }
 
-/// The elements of an ASCII block: triangles and quads kept, the rest skipped (a line
-/// each when the type is unknown).
+/// The elements of an ASCII block, one per line: triangles and quads kept, the rest
+/// skipped.
 fn element_block41_ascii(
     p: &mut Parser<'_>,
     c: &mut Content,
@@ -841,62 +1117,67 @@ fn element_block41_ascii(
 ) -> Res<()> {
     let s = "$Elements";
     let blk = b.index;
-    let nn = nodes_per_element(b.etype);
-    if b.etype == TRIANGLE || b.etype == QUAD {
-        let nn = if b.etype == TRIANGLE { 3 } else { 4 };
-        if b.etype == TRIANGLE {
-            let k = cap(b.len, 8, p.b.len() - p.pos);
-            c.data.triangles.reserve(k);
-            c.data.triangle_ids.reserve(k);
-            c.data.triangle_surface.reserve(k);
-        }
-        let mut nodes = [0u64; 4];
-        for i in 0..b.len {
-            let (at, tt) = p.need(s, &|| format!("element {} of block {}", i + 1, blk + 1))?;
-            let tag = parse_u64(tt).ok_or_else(|| {
-                p.bad_token(at, tt, s, &|| {
-                    format!("the tag of element {} of block {}", i + 1, blk + 1)
-                })
-            })?;
-            for slot in nodes.iter_mut().take(nn) {
-                *slot = p.uint(s, &|| format!("a node of element {tag}"))?;
-            }
-            push_element(p, c, map, at, tag, b.surface, &nodes[..nn])?;
-        }
-    } else {
-        for i in 0..b.len {
-            p.uint(s, &|| {
+    let keep = b.etype == TRIANGLE || b.etype == QUAD;
+    if b.etype == TRIANGLE {
+        let k = cap(b.len, 8, p.b.len() - p.pos);
+        c.data.triangles.reserve(k);
+        c.data.triangle_ids.reserve(k);
+        c.data.triangle_surface.reserve(k);
+    }
+    let mut nodes = [0u64; 4];
+    for i in 0..b.len {
+        let (at, tt) = p.need(s, &|| format!("element {} of block {}", i + 1, blk + 1))?;
+        let tag = parse_u64(tt).ok_or_else(|| {
+            p.bad_token(at, tt, s, &|| {
                 format!("the tag of element {} of block {}", i + 1, blk + 1)
-            })?;
-            match nn {
-                Some(k) => {
-                    for _ in 0..k {
-                        p.uint(s, &|| {
-                            format!("a node of element {} of block {}", i + 1, blk + 1)
-                        })?;
-                    }
-                }
-                None => p.skip_line(),
+            })
+        })?;
+        p.entry_start();
+        if b.nodes == 0 {
+            p.skip_line();
+            continue;
+        }
+        for k in 0..b.nodes {
+            let v = p.uint(s, &|| format!("node {} of element {tag}", k + 1))?;
+            if let (true, Some(slot)) = (keep, nodes.get_mut(k)) {
+                *slot = v;
             }
         }
-        c.ignored += b.len as usize;
+        p.entry_end(&|| element_nodes(tag, b.etype, b.nodes))?;
+        if keep {
+            push_element(p, c, map, at, tag, b.surface, &nodes[..b.nodes])?;
+        }
+    }
+    if !keep {
+        c.skip(b.etype, b.len);
     }
     Ok(())
 }
 
-/// The elements of a binary block (fixed-size records: an unknown type, found at byte
-/// `tp`, is an error, as its size is unknown).
+/// What an element line holds, for messages: "the 3 nodes of element 72 (type 2)".
+fn element_nodes(tag: u64, etype: i64, nodes: usize) -> String {
+    match nodes {
+        1 => format!("the node of element {tag} (type {etype})"),
+        _ => format!("the {nodes} nodes of element {tag} (type {etype})"),
+    }
+}
+
+/// The message for an element type Gmsh does not know; `what` names the element or block.
+fn unknown_type(what: &str, etype: i64) -> String {
+    format!(
+        "{what} has type {etype}, which is not a Gmsh element type (Gmsh 4.15 numbers its types 1 to 137)"
+    )
+}
+
+/// The elements of a binary block (fixed-size records).
 fn element_block41_binary(
     p: &mut Parser<'_>,
     c: &mut Content,
     map: &NodeMap,
     b: &Block41,
-    tp: usize,
 ) -> Res<()> {
     let s = "$Elements";
-    let Some(nn) = nodes_per_element(b.etype) else {
-        return Err(p.err(tp, format!("unknown element type {}", b.etype)));
-    };
+    let nn = b.nodes;
     let stride = 8 * (1 + nn);
     let at0 = p.pos;
     let data = p.take_array(b.len, stride, s, &|| {
@@ -912,14 +1193,15 @@ fn element_block41_binary(
             push_element(p, c, map, at0 + i * stride, tag, b.surface, &nodes[..nn])?;
         }
     } else {
-        c.ignored += b.len as usize;
+        c.skip(b.etype, b.len);
     }
     Ok(())
 }
 
-/// Surface of an MSH 2.2 element: its elementary tag (the second tag), else 1.
+/// Surface of an MSH 2.2 element: its elementary tag (the second tag), else 0 (as Gmsh
+/// reads it: an element without one is on entity 0, not on another surface).
 fn surface22(tags: &[i64]) -> i64 {
-    tags.get(1).copied().unwrap_or(1)
+    tags.get(1).copied().unwrap_or(0)
 }
 
 fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
@@ -939,7 +1221,12 @@ fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u
                 format!("the tag of element {} of {total}", i + 1)
             })
         })?;
+        p.entry_start();
+        let tp = p.pos;
         let etype = p.int(s, &|| format!("the type of element {tag}"))?;
+        let Some((nn, _, _)) = element_type(etype) else {
+            return Err(p.err(tp, unknown_type(&format!("element {tag}"), etype)));
+        };
         let ntags = p.uint(s, &|| format!("the number of tags of element {tag}"))?;
         for k in 0..ntags {
             let v = p.int(s, &|| format!("a tag of element {tag}"))?;
@@ -947,24 +1234,25 @@ fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u
                 *slot = v;
             }
         }
-        if etype == TRIANGLE || etype == QUAD {
-            let nn = if etype == TRIANGLE { 3 } else { 4 };
-            for slot in nodes.iter_mut().take(nn) {
-                *slot = p.uint(s, &|| format!("a node of element {tag}"))?;
+        let keep = etype == TRIANGLE || etype == QUAD;
+        if !keep {
+            c.skip(etype, 1);
+        }
+        if nn == 0 {
+            p.skip_line();
+            continue;
+        }
+        for k in 0..nn {
+            let v = p.uint(s, &|| format!("node {} of element {tag}", k + 1))?;
+            if let (true, Some(slot)) = (keep, nodes.get_mut(k)) {
+                *slot = v;
             }
+        }
+        p.entry_end(&|| element_nodes(tag, etype, nn))?;
+        if keep {
             let used = &tags[..(ntags as usize).min(2)];
             let surface = to_i32(p, at, surface22(used), "elementary tag")?;
             push_element(p, c, map, at, tag, surface, &nodes[..nn])?;
-        } else {
-            match nodes_per_element(etype) {
-                Some(k) => {
-                    for _ in 0..k {
-                        p.uint(s, &|| format!("a node of element {tag}"))?;
-                    }
-                }
-                None => p.skip_line(),
-            }
-            c.ignored += 1;
         }
     }
     Ok(total)
@@ -991,14 +1279,23 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
                 ),
             ));
         }
-        let Some(nn) = nodes_per_element(etype) else {
-            return Err(p.err_bin(hp, format!("unknown element type {etype}")));
+        let Some((nn, _, name)) = element_type(etype) else {
+            return Err(p.err(hp, unknown_type("an element group", etype)));
         };
+        if nn == 0 {
+            return Err(p.err(
+                hp,
+                format!(
+                    "elements of type {etype} ({name}) have no fixed number of nodes: not read in binary files"
+                ),
+            ));
+        }
         let ntags = ntags as usize;
         let stride = 4 * (1 + ntags + nn);
         let at0 = p.pos;
         let data = p.take_array(n as u64, stride, s, &|| {
-            format!("{n} elements of type {etype}")
+            let plural = if n == 1 { "" } else { "s" };
+            format!("a group of {n} element{plural} of type {etype}")
         })?;
         if etype == TRIANGLE || etype == QUAD {
             for (i, e) in data.chunks_exact(stride).enumerate() {
@@ -1007,7 +1304,7 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
                 if tag <= 0 {
                     return Err(p.err_bin(at, format!("bad element tag {tag} (tags are positive)")));
                 }
-                let surface = if ntags >= 2 { i32_at(e, 8) } else { 1 };
+                let surface = if ntags >= 2 { i32_at(e, 8) } else { 0 };
                 for (k, slot) in nodes.iter_mut().take(nn).enumerate() {
                     let v = i32_at(e, 4 * (1 + ntags + k));
                     *slot = u64::try_from(v).unwrap_or(0);
@@ -1015,7 +1312,7 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
                 push_element(p, c, map, at, tag as u64, surface, &nodes[..nn])?;
             }
         } else {
-            c.ignored += n as usize;
+            c.skip(etype, n as u64);
         }
         seen += n as u64;
     }
