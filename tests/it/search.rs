@@ -267,6 +267,10 @@ fn uniform_tree_equals_exhaustive_search() {
         (grid(4, 3, 0.45, SEED, |_, _| true, |_, _| 1), 3),
         (grid(3, 3, 0.3, SEED + 5, |i, j| i + j != 2, |_, _| 1), 4),
         (strip(9), 3),
+        // Many equal rewards (a regular grid): ties decide the first action.
+        (grid(4, 4, 0.0, SEED, |_, _| true, |_, _| 1), 3),
+        (grid(5, 3, 0.0, SEED, |i, j| i + j != 3, |_, _| 1), 4),
+        (grid(6, 5, 0.2, SEED + 9, |_, _| true, |_, _| 1), 3),
     ] {
         let table = CandidateTable::build(&mesh);
         let mut order: Vec<u32> = (0..table.len() as u32).collect();
