@@ -14,9 +14,15 @@ pub enum MeshError {
     #[error("the mesh has no triangles (nothing to recombine)")]
     NoTriangles,
     #[error(
-        "the mesh has no 3-node triangles to recombine: its surface elements are {skipped}, which are not read (only first-order triangles and quads are; make the mesh first order, e.g. gmsh.model.mesh.setOrder(1) before writing it, or Gmsh's -order 1 option)"
+        "the mesh has no 3-node triangles to recombine: its surface elements are {skipped}, which are not read (only 3-node triangles and 4-node quads are{hint})"
     )]
-    OnlySkippedSurfaceElements { skipped: String },
+    OnlySkippedSurfaceElements {
+        /// The skipped surface elements, per type ("212 Triangle 6 (type 9)").
+        skipped: String,
+        /// What to do about them, when there is something to do (high-order elements: make
+        /// the mesh first order); empty otherwise.
+        hint: String,
+    },
     #[error(
         "the mesh is too large: {vertices} vertices, {triangles} triangles (at most 2^32 - 2 each)"
     )]

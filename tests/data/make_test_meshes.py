@@ -48,6 +48,11 @@ gmsh.option.setNumber("Mesh.SaveParametric", 1)
 gmsh.write("param_41_ascii.msh")
 gmsh.option.setNumber("Mesh.Binary", 1)
 gmsh.write("param_41_bin.msh")
+# MSH 2.2 writes them in a $ParametricNodes section instead of $Nodes.
+gmsh.option.setNumber("Mesh.MshFileVersion", 2.2)
+gmsh.write("param_22_bin.msh")
+gmsh.option.setNumber("Mesh.Binary", 0)
+gmsh.write("param_22_ascii.msh")
 gmsh.finalize()
 
 # A mesh split into two partitions (MSH 4.1 puts each partition's elements on new entities,
@@ -83,4 +88,25 @@ gmsh.model.mesh.setOrder(2)
 gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
 gmsh.option.setNumber("Mesh.Binary", 0)
 gmsh.write("order2_41_ascii.msh")
+gmsh.finalize()
+
+# A partitioned 3D mesh (a box of tetrahedra in two partitions): with Gmsh's default
+# PartitionCreateTopology, MSH 4.1 adds partition surfaces whose parent is the volume (the
+# interface between the partitions), holding triangles inside the box: the reader skips
+# them. The unpartitioned mesh is written first, for comparison.
+gmsh.initialize()
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.model.add("box")
+gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+gmsh.model.occ.synchronize()
+gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5)
+gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
+gmsh.model.mesh.generate(3)
+gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+gmsh.option.setNumber("Mesh.Binary", 0)
+gmsh.write("box_41_ascii.msh")
+gmsh.model.mesh.partition(2)
+gmsh.write("box_parts_41_ascii.msh")
+gmsh.option.setNumber("Mesh.Binary", 1)
+gmsh.write("box_parts_41_bin.msh")
 gmsh.finalize()

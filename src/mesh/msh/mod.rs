@@ -68,32 +68,52 @@ pub struct SkippedElements {
     pub dim: u8,
     /// How many were skipped.
     pub count: usize,
+    /// True for elements on the interfaces between the volume partitions of a partitioned
+    /// 3D mesh (MSH 4.1 partition surfaces whose parent is a volume): triangles inside the
+    /// volume, skipped whatever their type.
+    pub on_partition_interfaces: bool,
+}
+
+impl SkippedElements {
+    /// True for surface elements of order 2 and up (Triangle 6, Quadrilateral 9, ...),
+    /// which `setOrder(1)` turns into the triangles and quads that are read: the surface
+    /// types with more than 4 nodes.
+    pub fn is_high_order(&self) -> bool {
+        self.dim == 2 && element_type(self.gmsh_type).is_some_and(|(nodes, _, _)| nodes > 4)
+    }
 }
 
 impl fmt::Display for SkippedElements {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} {} (type {})", self.count, self.name, self.gmsh_type)
+        write!(f, "{} {} (type {})", self.count, self.name, self.gmsh_type)?;
+        if self.on_partition_interfaces {
+            f.write_str(" on partition interfaces")?;
+        }
+        Ok(())
     }
 }
 
 impl MshFile {
     /// Validates the content into a [`Mesh`] (see [`Mesh::new`]); errors name `path`.
-    /// A file whose only surface elements are of higher order (or otherwise not read)
-    /// says so, rather than that it has no triangles.
+    /// A file whose only surface elements are of types not read (higher order, polygons,
+    /// partition interfaces) says so, rather than that it has no triangles, and says how
+    /// to make a high-order mesh first order.
     pub fn into_mesh(self, path: &Path) -> Result<Mesh, ReadError> {
-        let surface: Vec<String> = self
-            .skipped
-            .iter()
-            .filter(|k| k.dim == 2)
-            .map(ToString::to_string)
-            .collect();
+        let surface: Vec<&SkippedElements> = self.skipped.iter().filter(|k| k.dim == 2).collect();
+        let high_order = surface.iter().any(|k| k.is_high_order());
+        let skipped: Vec<String> = surface.iter().map(ToString::to_string).collect();
         let no_triangles = self.data.triangles.is_empty();
         Mesh::new(self.data).map_err(|source| ReadError::Mesh {
             path: path.to_path_buf(),
             source: match source {
-                MeshError::NoTriangles if no_triangles && !surface.is_empty() => {
+                MeshError::NoTriangles if no_triangles && !skipped.is_empty() => {
                     MeshError::OnlySkippedSurfaceElements {
-                        skipped: surface.join(", "),
+                        skipped: skipped.join(", "),
+                        hint: if high_order {
+                            "; make the mesh first order, e.g. gmsh.model.mesh.setOrder(1) before writing it, or Gmsh's -order 1 option".into()
+                        } else {
+                            String::new()
+                        },
                     }
                 }
                 e => e,

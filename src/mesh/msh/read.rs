@@ -7,14 +7,17 @@
 
 use super::{MshFile, MshVersion, SkippedElements};
 use crate::mesh::{MeshData, ReadError};
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 
-/// Gmsh's element types (4.15, as `gmsh.model.mesh.getElementProperties` gives them; a test
-/// checks the table against it): number, nodes (0: no fixed number, polygons and the like),
-/// dimension, name. Sorted by number.
+/// Gmsh's element types (4.15, as its MSH reader knows them: `MElement::getInfoMSH`):
+/// number, nodes (0: no fixed number, polygons and the like), dimension, name. Sorted by
+/// number. A test checks the table against `gmsh.model.mesh.getElementProperties`, which
+/// answers for all but 18 of them (the border and child lines, the border triangle, the
+/// prisms of order 3 and up and the trihedron, for which it raises another error than
+/// "Unknown type"); those rows are from `getInfoMSH`.
 #[rustfmt::skip]
-const ELEMENT_TYPES: [(i64, usize, u8, &str); 117] = [
+const ELEMENT_TYPES: [(i64, usize, u8, &str); 135] = [
     (1, 2, 1, "Line 2"),
     (2, 3, 2, "Triangle 3"),
     (3, 4, 2, "Quadrilateral 4"),
@@ -81,7 +84,10 @@ const ELEMENT_TYPES: [(i64, usize, u8, &str); 117] = [
     (64, 9, 1, "Line 9"),
     (65, 10, 1, "Line 10"),
     (66, 11, 1, "Line 11"),
+    (67, 2, 1, "Line Border"),
+    (68, 3, 2, "Triangle Border"),
     (69, 0, 2, "Polygon Border"),
+    (70, 2, 1, "Line Child"),
     (71, 84, 3, "Tetrahedron 84"),
     (72, 120, 3, "Tetrahedron 120"),
     (73, 165, 3, "Tetrahedron 165"),
@@ -98,6 +104,8 @@ const ELEMENT_TYPES: [(i64, usize, u8, &str); 117] = [
     (87, 1, 3, "Tetrahedron 1"),
     (88, 1, 3, "Hexahedron 1"),
     (89, 1, 3, "Prism 1"),
+    (90, 40, 3, "Prism 40"),
+    (91, 75, 3, "Prism 75"),
     (92, 64, 3, "Hexahedron 64"),
     (93, 125, 3, "Hexahedron 125"),
     (94, 216, 3, "Hexahedron 216"),
@@ -112,6 +120,18 @@ const ELEMENT_TYPES: [(i64, usize, u8, &str); 117] = [
     (103, 80, 3, "Hexahedron 80"),
     (104, 92, 3, "Hexahedron 92"),
     (105, 104, 3, "Hexahedron 104"),
+    (106, 126, 3, "Prism 126"),
+    (107, 196, 3, "Prism 196"),
+    (108, 288, 3, "Prism 288"),
+    (109, 405, 3, "Prism 405"),
+    (110, 550, 3, "Prism 550"),
+    (111, 24, 3, "Prism 24"),
+    (112, 33, 3, "Prism 33"),
+    (113, 42, 3, "Prism 42"),
+    (114, 51, 3, "Prism 51"),
+    (115, 60, 3, "Prism 60"),
+    (116, 69, 3, "Prism 69"),
+    (117, 78, 3, "Prism 78"),
     (118, 30, 3, "Pyramid 30"),
     (119, 55, 3, "Pyramid 55"),
     (120, 91, 3, "Pyramid 91"),
@@ -132,6 +152,7 @@ const ELEMENT_TYPES: [(i64, usize, u8, &str); 117] = [
     (135, 0, 2, "Triangle Xfem"),
     (136, 0, 3, "Tetrahedron Xfem"),
     (137, 16, 3, "Tetrahedron 16"),
+    (140, 4, 3, "Trihedron 4"),
 ];
 
 /// The nodes, dimension and name of Gmsh element type `etype`; `None` for a number Gmsh
@@ -474,8 +495,12 @@ impl<'a> Parser<'a> {
         }
     }
 
-    /// After a section header in a binary file: the single newline before the binary data.
-    fn newline_before_binary(&mut self) {
+    /// After a section header in a binary file: the single newline before the binary data
+    /// (nothing in an ASCII file, where the newline is whitespace).
+    fn binary_data_start(&mut self) {
+        if !self.binary {
+            return;
+        }
         if self.b.get(self.pos) == Some(&b'\r') {
             self.pos += 1;
         }
@@ -559,15 +584,24 @@ struct Content {
     data: MeshData,
     node_tags: Vec<u64>,
     map: Option<NodeMap>,
-    /// Skipped elements: count per Gmsh type.
-    skipped: BTreeMap<i64, usize>,
+    /// Skipped elements: count per Gmsh type and whether they were on a partition
+    /// interface (a surface inside a volume; see `interfaces`).
+    skipped: BTreeMap<(i64, bool), usize>,
     /// Partitioned files (4.1): the parent surface of each partition's surface entity.
-    parents: HashMap<i64, i64>,
+    parents: HashMap<i64, i32>,
+    /// Partitioned 3D meshes (4.1): partition surfaces whose parent is a volume, the
+    /// interfaces between volume partitions. Their triangles lie inside the volume, not on
+    /// a model surface, and are skipped.
+    interfaces: HashSet<i64>,
 }
 
 impl Content {
     fn skip(&mut self, etype: i64, n: u64) {
-        *self.skipped.entry(etype).or_default() += n as usize;
+        *self.skipped.entry((etype, false)).or_default() += n as usize;
+    }
+
+    fn skip_interface(&mut self, etype: i64, n: u64) {
+        *self.skipped.entry((etype, true)).or_default() += n as usize;
     }
 }
 
@@ -608,6 +642,12 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
     };
     let fmt = "$MeshFormat";
     p.token(); // $MeshFormat
+    if p.b.get(p.pos) == Some(&b'\r') && p.b.get(p.pos + 1) != Some(&b'\n') {
+        return Err(p.err(
+            p.pos,
+            "the lines end with a lone carriage return (\\r, classic Mac OS line ends), not \\n or \\r\\n: convert them first, e.g. tr '\\r' '\\n' < IN.msh > OUT.msh",
+        ));
+    }
     let (vp, vt) = p.need(fmt, &|| "the version number".into())?;
     let version = match vt {
         b"4.1" => MshVersion::V41,
@@ -638,7 +678,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
                     ),
                 ));
             }
-            p.newline_before_binary();
+            p.binary_data_start();
             let at = p.pos;
             let one = p.bin_i32(fmt, &|| "the endianness marker (int 1)".into())?;
             if one != 1 {
@@ -666,19 +706,31 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
         map: None,
         skipped: BTreeMap::new(),
         parents: HashMap::new(),
+        interfaces: HashSet::new(),
     };
     while let Some((start, name)) = p.token() {
         match name {
-            b"$Nodes" => {
+            b"$Nodes" | b"$ParametricNodes" => {
                 if c.map.is_some() {
                     return Err(p.err(start, "a second $Nodes section"));
                 }
-                match (version, p.binary) {
-                    (MshVersion::V41, _) => nodes41(&mut p, &mut c)?,
-                    (MshVersion::V22, false) => nodes22_ascii(&mut p, &mut c)?,
-                    (MshVersion::V22, true) => nodes22_binary(&mut p, &mut c)?,
-                }
-                p.end("$Nodes", &|| format!("{} nodes", c.node_tags.len()))?;
+                let section = if name == b"$Nodes" {
+                    match (version, p.binary) {
+                        (MshVersion::V41, _) => nodes41(&mut p, &mut c)?,
+                        (MshVersion::V22, false) => nodes22_ascii(&mut p, &mut c)?,
+                        (MshVersion::V22, true) => nodes22_binary(&mut p, &mut c)?,
+                    }
+                    "$Nodes"
+                } else if version == MshVersion::V22 {
+                    parametric_nodes22(&mut p, &mut c)?;
+                    "$ParametricNodes"
+                } else {
+                    return Err(p.err(
+                        start,
+                        "a $ParametricNodes section in an MSH 4.1 file (4.1 keeps parametric coordinates in $Nodes; $ParametricNodes is MSH 2)",
+                    ));
+                };
+                p.end(section, &|| format!("{} nodes", c.node_tags.len()))?;
                 let map = NodeMap::new(&c.node_tags).map_err(|t| {
                     p.err(start, format!("node tag {t} is defined twice in $Nodes"))
                 })?;
@@ -728,7 +780,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
             .chain(&mut c.data.quad_surface)
         {
             if let Some(&parent) = parents.get(&i64::from(*s)) {
-                *s = to_i32(&p, 0, parent, "parent entity tag")?;
+                *s = parent;
             }
         }
     }
@@ -740,13 +792,14 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
         skipped: c
             .skipped
             .into_iter()
-            .map(|(t, n)| {
+            .map(|((t, on_interface), n)| {
                 let (_, dim, name) = element_type(t).expect("skipped types are known");
                 SkippedElements {
                     gmsh_type: t,
                     name,
                     dim,
                     count: n,
+                    on_partition_interfaces: on_interface,
                 }
             })
             .collect(),
@@ -774,13 +827,12 @@ fn to_i32(p: &Parser<'_>, at: usize, v: i64, what: &str) -> Res<i32> {
 
 /// The `$PartitionedEntities` section of MSH 4.1 (a mesh split into partitions, whose
 /// elements are on new entities, one per partition and model entity): the parent of each
-/// partition surface, into `c.parents`. Reads up to the surfaces (points and curves are
+/// partition surface, into `c.parents`, or, for a surface cut from a volume (an interface
+/// between volume partitions), its tag into `c.interfaces`. Reads up to the surfaces (points and curves are
 /// read past); the caller skips the rest.
 fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     let s = "$PartitionedEntities";
-    if p.binary {
-        p.newline_before_binary();
-    }
+    p.binary_data_start();
     p.size_t(s, &|| "the number of partitions".into())?;
     let ghosts = p.size_t(s, &|| "the number of ghost entities".into())?;
     for _ in 0..ghosts {
@@ -796,6 +848,7 @@ fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
             let what = || format!("partition entity {} of dimension {dim}", i + 1);
             let tag = p.int_field(s, &what)?;
             let parent_dim = p.int_field(s, &what)?;
+            let pp = p.pos;
             let parent = p.int_field(s, &what)?;
             let parts = p.size_t(s, &what)?;
             for _ in 0..parts {
@@ -815,8 +868,17 @@ fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
                     p.int_field(s, &what)?;
                 }
             }
-            if dim == 2 && parent_dim == 2 {
-                c.parents.insert(tag, parent);
+            if dim == 2 {
+                match parent_dim {
+                    2 => {
+                        c.parents
+                            .insert(tag, to_i32(p, pp, parent, "parent entity tag")?);
+                    }
+                    3 => {
+                        c.interfaces.insert(tag);
+                    }
+                    _ => {}
+                }
             }
         }
     }
@@ -827,9 +889,7 @@ fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
 /// "element"): where it starts, the number of entity blocks and of items (the tag range is
 /// not used).
 fn header41(p: &mut Parser<'_>, s: &str, item: &str) -> Res<(usize, u64, u64)> {
-    if p.binary {
-        p.newline_before_binary();
-    }
+    p.binary_data_start();
     let hp = p.pos;
     let blocks = p.size_t(s, &|| "the number of entity blocks".into())?;
     p.entry_start();
@@ -977,10 +1037,64 @@ fn nodes22_ascii(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     Ok(())
 }
 
+/// The `$ParametricNodes` section of MSH 2.2 (written instead of `$Nodes` with Gmsh's
+/// `Mesh.SaveParametric`), in either encoding: per node, its tag, coordinates, the
+/// dimension and tag of the entity it is on, and its parametric coordinates on that entity
+/// (one on a curve, two on a surface, none on a point or volume), which are read past.
+fn parametric_nodes22(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
+    let s = "$ParametricNodes";
+    let total = p.uint(s, &|| "the number of nodes".into())?;
+    p.binary_data_start();
+    let left = p.b.len() - p.pos;
+    let min_bytes = if p.binary { 36 } else { 12 };
+    c.node_tags.reserve(cap(total, min_bytes, left));
+    c.data.vertices.reserve(cap(total, min_bytes, left));
+    for i in 0..total {
+        let tp = p.pos;
+        let tag = p.int_field(s, &|| format!("the tag of node {} of {total}", i + 1))?;
+        if tag <= 0 {
+            return Err(p.err(tp, format!("bad node tag {tag} (tags are positive)")));
+        }
+        p.entry_start();
+        let what = || format!("a coordinate of node {tag}");
+        let cp = p.pos;
+        let x = [
+            p.double_field(s, &what)?,
+            p.double_field(s, &what)?,
+            p.double_field(s, &what)?,
+        ];
+        let what = || format!("the entity of node {tag}");
+        let dp = p.pos;
+        let dim = p.int_field(s, &what)?;
+        p.int_field(s, &what)?;
+        let params = match dim {
+            0 | 3 => 0,
+            1 => 1,
+            2 => 2,
+            _ => {
+                return Err(p.err(
+                    dp,
+                    format!("node {tag} is on an entity of dimension {dim} (expected 0 to 3)"),
+                ));
+            }
+        };
+        for _ in 0..params {
+            p.double_field(s, &|| format!("a parametric coordinate of node {tag}"))?;
+        }
+        p.entry_end(&|| {
+            format!("the coordinates, entity and parametric coordinates of node {tag}")
+        })?;
+        check_finite(p, cp, tag as u64, x)?;
+        c.node_tags.push(tag as u64);
+        c.data.vertices.push(x);
+    }
+    Ok(())
+}
+
 fn nodes22_binary(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     let s = "$Nodes";
     let total = p.uint(s, &|| "the number of nodes".into())?;
-    p.newline_before_binary();
+    p.binary_data_start();
     let at = p.pos;
     let data = p.take_array(total, 28, s, &|| format!("{total} nodes"))?;
     c.node_tags.reserve(total as usize);
@@ -1038,7 +1152,7 @@ fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
     let mut seen = 0u64;
     for blk in 0..blocks {
         let what_blk = || format!("the header of element block {} of {blocks}", blk + 1);
-        p.int_field(s, &what_blk)?;
+        let entity_dim = p.int_field(s, &what_blk)?;
         p.entry_start();
         let ep = p.pos;
         let entity = p.int_field(s, &what_blk)?;
@@ -1069,16 +1183,12 @@ fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
             etype,
             nodes,
             surface,
+            on_interface: entity_dim == 2 && c.interfaces.contains(&entity),
         };
         if p.binary {
             if nodes == 0 {
-                return Err(p.err(
-                    tp,
-                    format!(
-                        "element block {} holds elements of type {etype} ({name}), which have no fixed number of nodes: not read in binary files",
-                        blk + 1
-                    ),
-                ));
+                let what = format!("element block {}", blk + 1);
+                return Err(p.err(tp, variable_size(&what, etype, name)));
             }
             element_block41_binary(p, c, map, &block)?;
         } else {
@@ -1105,6 +1215,24 @@ struct Block41 {
     /// Nodes per element (0: no fixed number).
     nodes: usize,
     surface: i32,
+    /// On a partition interface (skipped whatever its type).
+    on_interface: bool,
+}
+
+impl Block41 {
+    /// Whether the block's elements are read: triangles and quads not on an interface.
+    fn keep(&self) -> bool {
+        (self.etype == TRIANGLE || self.etype == QUAD) && !self.on_interface
+    }
+
+    /// Counts the block's elements as skipped.
+    fn skip(&self, c: &mut Content) {
+        if self.on_interface {
+            c.skip_interface(self.etype, self.len);
+        } else {
+            c.skip(self.etype, self.len);
+        }
+    }
 }
 
 /// The elements of an ASCII block, one per line: triangles and quads kept, the rest
@@ -1117,8 +1245,8 @@ fn element_block41_ascii(
 ) -> Res<()> {
     let s = "$Elements";
     let blk = b.index;
-    let keep = b.etype == TRIANGLE || b.etype == QUAD;
-    if b.etype == TRIANGLE {
+    let keep = b.keep();
+    if keep && b.etype == TRIANGLE {
         let k = cap(b.len, 8, p.b.len() - p.pos);
         c.data.triangles.reserve(k);
         c.data.triangle_ids.reserve(k);
@@ -1149,7 +1277,7 @@ fn element_block41_ascii(
         }
     }
     if !keep {
-        c.skip(b.etype, b.len);
+        b.skip(c);
     }
     Ok(())
 }
@@ -1162,10 +1290,18 @@ fn element_nodes(tag: u64, etype: i64, nodes: usize) -> String {
     }
 }
 
+/// The message for a binary block or group (`what`) of elements without a fixed number of
+/// nodes (polygons and the like), whose records have no fixed size.
+fn variable_size(what: &str, etype: i64, name: &str) -> String {
+    format!(
+        "{what} holds elements of type {etype} ({name}), which have no fixed number of nodes: not read in binary files"
+    )
+}
+
 /// The message for an element type Gmsh does not know; `what` names the element or block.
 fn unknown_type(what: &str, etype: i64) -> String {
     format!(
-        "{what} has type {etype}, which is not a Gmsh element type (Gmsh 4.15 numbers its types 1 to 137)"
+        "{what} has type {etype}, which is not a Gmsh element type (Gmsh 4.15 numbers its types 1 to 140)"
     )
 }
 
@@ -1183,7 +1319,7 @@ fn element_block41_binary(
     let data = p.take_array(b.len, stride, s, &|| {
         format!("element block {}", b.index + 1)
     })?;
-    if b.etype == TRIANGLE || b.etype == QUAD {
+    if b.keep() {
         let mut nodes = [0u64; 4];
         for (i, e) in data.chunks_exact(stride).enumerate() {
             let tag = u64_at(e, 0);
@@ -1193,7 +1329,7 @@ fn element_block41_binary(
             push_element(p, c, map, at0 + i * stride, tag, b.surface, &nodes[..nn])?;
         }
     } else {
-        c.skip(b.etype, b.len);
+        b.skip(c);
     }
     Ok(())
 }
@@ -1261,7 +1397,7 @@ fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u
 fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
     let s = "$Elements";
     let total = p.uint(s, &|| "the number of elements".into())?;
-    p.newline_before_binary();
+    p.binary_data_start();
     let mut seen = 0u64;
     let mut nodes = [0u64; 4];
     while seen < total {
@@ -1283,12 +1419,7 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
             return Err(p.err(hp, unknown_type("an element group", etype)));
         };
         if nn == 0 {
-            return Err(p.err(
-                hp,
-                format!(
-                    "elements of type {etype} ({name}) have no fixed number of nodes: not read in binary files"
-                ),
-            ));
+            return Err(p.err(hp, variable_size("an element group", etype, name)));
         }
         let ntags = ntags as usize;
         let stride = 4 * (1 + ntags + nn);
