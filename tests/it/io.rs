@@ -1,7 +1,7 @@
 //! Mesh input and output: the four MSH variants, round trips through the writers (and Gmsh),
 //! every bad input through the CLI, and a seeded mutation fuzzer over the MSH reader.
 
-use crate::util::{SEED, repo_path, run_in};
+use crate::util::{SEED, gmsh_available, python, repo_path, run_in};
 use quadrecomb::mesh::{self, Mesh, MeshError, ReadError, Recombined, msh, vtu};
 use quadrecomb::quality::{self, CandidateTable};
 use rand::{RngExt, SeedableRng};
@@ -74,21 +74,6 @@ fn quad_set(m: &Mesh) -> BTreeSet<([u64; 4], i32)> {
         .collect()
 }
 
-/// Whether the `gmsh` Python module can be used; in CI (`CI` set) it must be.
-fn gmsh_available() -> bool {
-    let ok = Command::new("python3")
-        .args(["-c", "import gmsh"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok && std::env::var_os("CI").is_some() {
-        panic!("the gmsh Python module is required in CI (pip install gmsh==4.15.2)");
-    }
-    if !ok {
-        eprintln!("skipping: python3 -c 'import gmsh' failed");
-    }
-    ok
-}
-
 /// Element counts (triangles, quads) and node count of `path` as Gmsh reads them.
 fn gmsh_counts(path: &Path) -> (usize, usize, usize) {
     let script = r#"
@@ -101,18 +86,7 @@ def count(t):
 print(count(2), count(3), len(gmsh.model.mesh.getNodes()[0]))
 gmsh.finalize()
 "#;
-    let out = Command::new("python3")
-        .args(["-c", script])
-        .arg(path)
-        .output()
-        .expect("run python3");
-    assert!(
-        out.status.success(),
-        "gmsh could not open {}: {}",
-        path.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let s = String::from_utf8_lossy(&out.stdout);
+    let s = python(script, &[path]);
     let v: Vec<usize> = s.split_whitespace().map(|x| x.parse().unwrap()).collect();
     (v[0], v[1], v[2])
 }
@@ -1075,16 +1049,7 @@ for t in range(1, 301):
         print(f"{t}|{'none' if unknown else 'noprops'}")
 gmsh.finalize()
 "#;
-    let out = Command::new("python3")
-        .args(["-c", script])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = python(script, &[]);
     let (mut known, mut no_props) = (0, Vec::new());
     for line in text.lines() {
         let f: Vec<&str> = line.split('|').collect();

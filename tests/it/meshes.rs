@@ -1,7 +1,7 @@
 //! Benchmark meshes: the embedded built-in files and the procedural generators (grid,
 //! icosphere), through the library and the `generate` subcommand.
 
-use crate::util::{SEED, repo_path, run_in};
+use crate::util::{SEED, gmsh_available, python, repo_path, run_in};
 use quadrecomb::mesh::generate::{
     self, GenerateError, GridSpec, MAX_SUBDIVISIONS, grid, icosphere, icosphere_with_triangles,
 };
@@ -92,19 +92,10 @@ fn builtin_files_are_embedded_and_have_the_expected_triangles() {
     assert!(builtin::bytes("nope").is_none());
 }
 
-/// Whether `python3` can import `gmsh` 4.15.2.
-fn has_gmsh() -> bool {
-    std::process::Command::new("python3")
-        .args(["-c", "import gmsh; assert gmsh.__version__ == '4.15.2'"])
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
-
 /// The committed files are what `scripts/make_meshes.py` makes (when Python has `gmsh`).
 #[test]
 fn builtin_files_are_reproducible_with_gmsh() {
-    if !has_gmsh() {
-        eprintln!("skipped: python3 with gmsh 4.15.2 not available");
+    if !gmsh_available() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -697,8 +688,7 @@ fn cli_generate_grid_writes_the_library_grid() {
     assert_eq!(back.surfaces(), vec![1, 2]);
 
     // Gmsh opens it with the same counts.
-    if !has_gmsh() {
-        eprintln!("skipped the Gmsh check: python3 with gmsh 4.15.2 not available");
+    if !gmsh_available() {
         return;
     }
     let script = "import gmsh, sys\n\
@@ -708,17 +698,7 @@ fn cli_generate_grid_writes_the_library_grid() {
         types, tags, _ = gmsh.model.mesh.getElements(2)\n\
         print(len(gmsh.model.mesh.getNodes()[0]), sum(len(t) for t in tags), \n\
               len(gmsh.model.getEntities(2)), [int(t) for t in types])\n";
-    let out = std::process::Command::new("python3")
-        .args(["-c", script])
-        .arg(dir.path().join("g.msh"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let line = String::from_utf8_lossy(&out.stdout);
+    let line = python(script, &[&dir.path().join("g.msh")]);
     assert_eq!(
         line.trim(),
         format!("{} {} 2 [2]", mesh.vertices.len(), mesh.num_triangles())

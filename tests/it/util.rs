@@ -21,6 +21,39 @@ pub fn run_in(dir: &Path, args: &[&str]) -> Output {
         .expect("run quadrecomb")
 }
 
+/// Whether `python3` can import `gmsh` 4.15.2 (the version the test meshes and expected
+/// figures come from). Outside CI a test without it skips with a message; in CI (`CI` set)
+/// it must be there, so that no Gmsh check is skipped silently.
+pub fn gmsh_available() -> bool {
+    let ok = Command::new("python3")
+        .args(["-c", "import gmsh; assert gmsh.__version__ == '4.15.2'"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok && std::env::var_os("CI").is_some() {
+        panic!("the gmsh Python module 4.15.2 is required in CI (pip install gmsh==4.15.2)");
+    }
+    if !ok {
+        eprintln!("skipping a Gmsh check: python3 cannot import gmsh 4.15.2");
+    }
+    ok
+}
+
+/// Runs `python3 -c script args...` and returns its standard output; panics with its
+/// standard error if it fails.
+pub fn python(script: &str, args: &[&Path]) -> String {
+    let out = Command::new("python3")
+        .args(["-c", script])
+        .args(args)
+        .output()
+        .expect("run python3");
+    assert!(
+        out.status.success(),
+        "python3 failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8 output")
+}
+
 /// Path of a file in the repository.
 pub fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
