@@ -596,12 +596,9 @@ struct Content {
 }
 
 impl Content {
-    fn skip(&mut self, etype: i64, n: u64) {
-        *self.skipped.entry((etype, false)).or_default() += n as usize;
-    }
-
-    fn skip_interface(&mut self, etype: i64, n: u64) {
-        *self.skipped.entry((etype, true)).or_default() += n as usize;
+    /// Counts `n` skipped elements of type `etype` (on a partition interface or not).
+    fn skip(&mut self, etype: i64, n: u64, on_interface: bool) {
+        *self.skipped.entry((etype, on_interface)).or_default() += n as usize;
     }
 }
 
@@ -828,8 +825,8 @@ fn to_i32(p: &Parser<'_>, at: usize, v: i64, what: &str) -> Res<i32> {
 /// The `$PartitionedEntities` section of MSH 4.1 (a mesh split into partitions, whose
 /// elements are on new entities, one per partition and model entity): the parent of each
 /// partition surface, into `c.parents`, or, for a surface cut from a volume (an interface
-/// between volume partitions), its tag into `c.interfaces`. Reads up to the surfaces (points and curves are
-/// read past); the caller skips the rest.
+/// between volume partitions), its tag into `c.interfaces`. Reads up to the surfaces
+/// (points and curves are read past); the caller skips the rest.
 fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     let s = "$PartitionedEntities";
     p.binary_data_start();
@@ -1224,15 +1221,6 @@ impl Block41 {
     fn keep(&self) -> bool {
         (self.etype == TRIANGLE || self.etype == QUAD) && !self.on_interface
     }
-
-    /// Counts the block's elements as skipped.
-    fn skip(&self, c: &mut Content) {
-        if self.on_interface {
-            c.skip_interface(self.etype, self.len);
-        } else {
-            c.skip(self.etype, self.len);
-        }
-    }
 }
 
 /// The elements of an ASCII block, one per line: triangles and quads kept, the rest
@@ -1277,7 +1265,7 @@ fn element_block41_ascii(
         }
     }
     if !keep {
-        b.skip(c);
+        c.skip(b.etype, b.len, b.on_interface);
     }
     Ok(())
 }
@@ -1329,7 +1317,7 @@ fn element_block41_binary(
             push_element(p, c, map, at0 + i * stride, tag, b.surface, &nodes[..nn])?;
         }
     } else {
-        b.skip(c);
+        c.skip(b.etype, b.len, b.on_interface);
     }
     Ok(())
 }
@@ -1372,7 +1360,7 @@ fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u
         }
         let keep = etype == TRIANGLE || etype == QUAD;
         if !keep {
-            c.skip(etype, 1);
+            c.skip(etype, 1, false);
         }
         if nn == 0 {
             p.skip_line();
@@ -1443,7 +1431,7 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
                 push_element(p, c, map, at, tag as u64, surface, &nodes[..nn])?;
             }
         } else {
-            c.skip(etype, n as u64);
+            c.skip(etype, n as u64, false);
         }
         seen += n as u64;
     }
