@@ -64,18 +64,121 @@ pub fn quad_eta(p: [[f64; 3]; 4]) -> f64 {
     eta_from_angles([a0, a1, a2, a3])
 }
 
-/// eta of a quad given as a cycle of four corners, as a mesh file holds it: read as its two
-/// triangles either side of the diagonal from the first corner to the third (as
-/// [`quad_eta`]), and 0 when those halves face opposite ways (folded by more than 90 degrees
-/// about the diagonal, as a self-intersecting "bowtie" is). Candidates never are: their
-/// triangles are consistently oriented neighbours.
+/// eta of a quad given as a cycle of four corners, as a mesh file holds it: eq. 1 on its four
+/// corner angles (the angle between the two sides meeting at each corner), whichever diagonal
+/// a writer had in mind. A corner that turns against the quad's orientation (a reflex corner,
+/// or one lobe of a self-intersecting "bowtie") has an interior angle above pi: eta 0. The
+/// orientation is the quad's vector area (Newell's normal), so curved-surface quads work.
+/// Recombined candidates are read across their diagonal instead ([`quad_eta`]): on a planar
+/// quad both give the same value.
 pub fn input_quad_eta(p: [[f64; 3]; 4]) -> f64 {
     use crate::mesh::topology::{cross, dot, sub};
-    let [a, b, c, d] = p;
-    if dot(cross(sub(c, a), sub(d, a)), cross(sub(b, a), sub(c, a))) < 0.0 {
+    // Relative to the centroid, scaled to unit size, so that neither the products below nor
+    // the tolerance depend on the coordinates' magnitude.
+    let c = [0, 1, 2].map(|k| p.iter().map(|v| v[k]).sum::<f64>() / 4.0);
+    let rel = p.map(|v| sub(v, c));
+    let m = rel.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    if m == 0.0 || !m.is_finite() {
         return 0.0;
     }
-    quad_eta(p)
+    let q = rel.map(|v| v.map(|x| x / m));
+    let mut normal = [0.0; 3];
+    for k in 0..4 {
+        let x = cross(q[k], q[(k + 1) % 4]);
+        normal = [normal[0] + x[0], normal[1] + x[1], normal[2] + x[2]];
+    }
+    let mut alpha = [0.0; 4];
+    for k in 0..4 {
+        let (prev, here, next) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
+        if dot(cross(sub(here, prev), sub(next, here)), normal) <= 0.0 {
+            return 0.0;
+        }
+        alpha[k] = angle(here, prev, next);
+    }
+    eta_from_angles(alpha)
+}
+
+/// Which pairs of neighbouring triangles may be merged: the actions of every policy and the
+/// edges of the optimum's matching.
+///
+/// A quad with a corner angle `>= pi` (eta = 0 in eq. 1: not strictly convex, or folded) is no
+/// element a finite-element solver accepts, so by default it is not an action at all. The
+/// decision is taken on the f64 reference eta ([`quad_eta`]), whatever computed the rewards,
+/// so every backend allows the same pairs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Rule {
+    /// Only quads with eta > 0 (strictly convex, not folded) and eta >= `min_eta`.
+    Valid {
+        /// Lowest eta of a quad that may be made; 0 means any strictly convex quad.
+        min_eta: f64,
+    },
+    /// Every pair of neighbouring triangles, eta-0 quads included (reward 0): the paper as
+    /// written, under which the earlier results were made (`--allow-invalid`).
+    AllPairs,
+}
+
+impl Default for Rule {
+    fn default() -> Rule {
+        Rule::Valid { min_eta: 0.0 }
+    }
+}
+
+impl Rule {
+    /// The rule from its two settings: `allow_invalid` keeps every pair (and then
+    /// `min_eta` must be 0), else the valid-quad rule with threshold `min_eta` in `[0, 1]`.
+    pub fn new(min_eta: f64, allow_invalid: bool) -> Result<Rule, RuleError> {
+        if !(0.0..=1.0).contains(&min_eta) {
+            return Err(RuleError::MinEtaRange(min_eta));
+        }
+        match (allow_invalid, min_eta > 0.0) {
+            (true, true) => Err(RuleError::Conflict(min_eta)),
+            (true, false) => Ok(Rule::AllPairs),
+            (false, _) => Ok(Rule::Valid { min_eta }),
+        }
+    }
+
+    /// The threshold: 0 for [`Rule::AllPairs`].
+    pub fn min_eta(&self) -> f64 {
+        match *self {
+            Rule::Valid { min_eta } => min_eta,
+            Rule::AllPairs => 0.0,
+        }
+    }
+
+    /// True for [`Rule::AllPairs`].
+    pub fn allows_invalid(&self) -> bool {
+        matches!(self, Rule::AllPairs)
+    }
+
+    /// Does the rule allow a quad of f64 quality `eta`?
+    #[inline]
+    pub fn allows(&self, eta: f64) -> bool {
+        match *self {
+            Rule::Valid { min_eta } => eta > 0.0 && eta >= min_eta,
+            Rule::AllPairs => true,
+        }
+    }
+}
+
+/// Short name of the rule as reports print it: `valid quads (eta > 0)`, `eta >= 0.3`,
+/// `all pairs (paper-literal)`.
+impl std::fmt::Display for Rule {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Rule::Valid { min_eta } if min_eta > 0.0 => write!(f, "valid quads, eta >= {min_eta}"),
+            Rule::Valid { .. } => f.write_str("valid quads (eta > 0)"),
+            Rule::AllPairs => f.write_str("all pairs, eta-0 quads included (paper-literal)"),
+        }
+    }
+}
+
+/// Settings that make no [`Rule`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RuleError {
+    #[error("the lowest eta must lie in [0, 1], not {0}")]
+    MinEtaRange(f64),
+    #[error("a lowest eta of {0} contradicts allowing invalid quads (which allows every pair)")]
+    Conflict(f64),
 }
 
 /// The candidate table: one entry per pair of neighbouring triangles (dual-graph edge).
@@ -141,6 +244,95 @@ impl CandidateTable {
         table
     }
 
+    /// The table of the candidates `rule` allows, in the same order (so indices shift past
+    /// each dropped one); the dropped pairs are no neighbours in its dual graph
+    /// ([`CandidateTable::dual_graph`]). Validity is decided on the f64 eta of each quad,
+    /// computed here, so the result does not depend on what filled `eta`.
+    pub fn restrict(self, mesh: &Mesh, rule: Rule) -> CandidateTable {
+        if rule == Rule::AllPairs {
+            return self;
+        }
+        let keep: Vec<bool> = self
+            .quads
+            .iter()
+            .map(|q| rule.allows(quad_eta(q.map(|v| mesh.vertices[v as usize]))))
+            .collect();
+        self.retain(&keep)
+    }
+
+    /// The table of the candidates `c` with `keep[c]`, in the same order.
+    pub fn retain(self, keep: &[bool]) -> CandidateTable {
+        assert_eq!(keep.len(), self.len(), "one flag per candidate");
+        if keep.iter().all(|&k| k) {
+            return self;
+        }
+        let mut new_index = vec![NONE; self.len()];
+        let mut out = CandidateTable {
+            by_triangle: self.by_triangle,
+            ..CandidateTable::default()
+        };
+        for c in (0..self.pairs.len()).filter(|&c| keep[c]) {
+            new_index[c] = out.pairs.len() as u32;
+            out.pairs.push(self.pairs[c]);
+            out.quads.push(self.quads[c]);
+            out.eta.push(self.eta[c]);
+        }
+        for sides in &mut out.by_triangle {
+            for c in sides.iter_mut().filter(|c| **c != NONE) {
+                *c = new_index[*c as usize];
+            }
+        }
+        out
+    }
+
+    /// The dual graph the candidates make: for each triangle, the triangle across each side
+    /// through a candidate, or [`NONE`]. Without restriction it is the mesh's
+    /// (`Topology::neighbours`); after [`CandidateTable::restrict`], the pairs dropped are cut.
+    pub fn dual_graph(&self) -> Vec<[u32; 3]> {
+        self.by_triangle
+            .iter()
+            .enumerate()
+            .map(|(t, sides)| {
+                sides.map(|c| {
+                    if c == NONE {
+                        NONE
+                    } else {
+                        self.other(c, t as u32)
+                    }
+                })
+            })
+            .collect()
+    }
+
+    /// Connected components of [`CandidateTable::dual_graph`] (`dual`): the component of
+    /// each triangle, numbered in order of their first triangle, and their sizes. These are
+    /// the initial polders.
+    pub fn components(dual: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
+        let mut component = vec![NONE; dual.len()];
+        let mut sizes = Vec::new();
+        let mut stack = Vec::new();
+        for start in 0..dual.len() {
+            if component[start] != NONE {
+                continue;
+            }
+            let id = sizes.len() as u32;
+            component[start] = id;
+            stack.push(start as u32);
+            let mut size = 0u32;
+            while let Some(t) = stack.pop() {
+                size += 1;
+                for &u in &dual[t as usize] {
+                    if u != NONE && component[u as usize] == NONE {
+                        component[u as usize] = id;
+                        stack.push(u);
+                    }
+                }
+            }
+            sizes.push(size);
+        }
+        (component, sizes)
+    }
+
     /// Number of candidates.
     pub fn len(&self) -> usize {
         self.pairs.len()
@@ -161,6 +353,46 @@ impl CandidateTable {
     pub fn other(&self, c: u32, t: u32) -> u32 {
         let [a, b] = self.pairs[c as usize];
         if a == t { b } else { a }
+    }
+}
+
+/// Element quality of a set of quads beside their sum: the worst, the mean, and how many are
+/// poor. A high sum with many triangles left, or with a few near-degenerate quads, is not a
+/// better mesh; these say so.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct ElementQuality {
+    /// The lowest eta (`None` without quads).
+    pub worst: Option<f64>,
+    /// The mean eta (`None` without quads).
+    pub mean: Option<f64>,
+    /// Quads with eta < 0.1.
+    pub below_0_1: usize,
+    /// Quads with eta < 0.3.
+    pub below_0_3: usize,
+}
+
+impl ElementQuality {
+    /// The figures of quads of quality `eta`.
+    pub fn of(eta: impl IntoIterator<Item = f64>) -> ElementQuality {
+        let (mut n, mut sum, mut worst) = (0usize, 0.0, f64::INFINITY);
+        let mut out = ElementQuality::default();
+        for e in eta {
+            n += 1;
+            sum += e;
+            worst = worst.min(e);
+            out.below_0_1 += usize::from(e < 0.1);
+            out.below_0_3 += usize::from(e < 0.3);
+        }
+        if n > 0 {
+            out.worst = Some(worst);
+            out.mean = Some(sum / n as f64);
+        }
+        out
+    }
+
+    /// The figures of the candidates `chosen` of `table`.
+    pub fn of_chosen(table: &CandidateTable, chosen: &[u32]) -> ElementQuality {
+        ElementQuality::of(chosen.iter().map(|&c| table.eta[c as usize]))
     }
 }
 
@@ -239,6 +471,42 @@ mod tests {
         // fold, quad_eta alone gives 0.5.
         assert_eq!(quad_eta([a, c, b, d]), 0.5);
         assert_eq!(input_quad_eta([a, c, b, d]), 0.0);
+    }
+
+    #[test]
+    fn input_quads_are_read_by_their_corners_not_a_diagonal() {
+        // A kite whose diagonal 1-3 makes two different triangles than 2-4: read from any
+        // starting corner, in either direction, it has the same eta (the corners' angles).
+        let kite = [
+            [0.0, 0.0, 0.0],
+            [2.0, -0.5, 0.0],
+            [3.0, 0.3, 0.0],
+            [1.0, 1.7, 0.0],
+        ];
+        let want = input_quad_eta(kite);
+        assert!(want > 0.2 && want < 0.9, "{want}");
+        for shift in 0..4 {
+            let p: [[f64; 3]; 4] = std::array::from_fn(|k| kite[(k + shift) % 4]);
+            let r: [[f64; 3]; 4] = std::array::from_fn(|k| p[3 - k]);
+            assert!((input_quad_eta(p) - want).abs() < 1e-12);
+            assert!((input_quad_eta(r) - want).abs() < 1e-12);
+        }
+        // On a planar convex quad, the same as the candidate reading across 1-3.
+        assert!((quad_eta(kite) - want).abs() < 1e-12);
+        // A dart: reflex corner at index 2, whichever diagonal is taken.
+        let dart = [
+            [0.0, 0.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [0.3, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        for shift in 0..4 {
+            let p: [[f64; 3]; 4] = std::array::from_fn(|k| dart[(k + shift) % 4]);
+            assert_eq!(input_quad_eta(p), 0.0);
+        }
+        // The same dart read across its other diagonal (corners 2-4) looked convex before.
+        let p: [[f64; 3]; 4] = std::array::from_fn(|k| dart[(k + 1) % 4]);
+        assert!(quad_eta(p) > 0.0);
     }
 
     #[test]

@@ -67,6 +67,61 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
     if bad_input { EXIT_BAD_INPUT } else { 1 }
 }
 
+/// Which pairs may be merged: the flags of every command that recombines.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct RuleArgs {
+    /// Make no quad with eta below E (in [0, 1]). Quads with eta = 0 (a corner angle >= 180
+    /// degrees: not strictly convex, or folded) are never made unless --allow-invalid.
+    #[arg(
+        long,
+        value_name = "E",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    min_eta: f64,
+    /// Every pair of neighbouring triangles is an action, eta-0 quads included (reward 0):
+    /// the paper as written, under which results before the valid-quad rule were made.
+    #[arg(long, conflicts_with = "min_eta")]
+    allow_invalid: bool,
+}
+
+impl RuleArgs {
+    /// The rule, or a usage error naming the flag.
+    pub fn rule(&self) -> Result<quadrecomb::quality::Rule, BadInput> {
+        quadrecomb::quality::Rule::new(self.min_eta, self.allow_invalid)
+            .map_err(|e| BadInput(format!("--min-eta: {e}")))
+    }
+}
+
+/// Adds the element-quality fields and the rule to a `--json` object (the record's names).
+pub fn add_element_fields(
+    v: &mut serde_json::Value,
+    e: &quadrecomb::quality::ElementQuality,
+    rule: quadrecomb::quality::Rule,
+) {
+    v["worst_eta"] = serde_json::json!(e.worst);
+    v["mean_eta"] = serde_json::json!(e.mean);
+    v["quads_eta_below_0_1"] = serde_json::json!(e.below_0_1);
+    v["quads_eta_below_0_3"] = serde_json::json!(e.below_0_3);
+    v["min_eta"] = serde_json::json!(rule.min_eta());
+    v["allow_invalid"] = serde_json::json!(rule.allows_invalid());
+}
+
+/// The element-quality lines of the text output.
+pub fn print_element_lines(
+    e: &quadrecomb::quality::ElementQuality,
+    rule: quadrecomb::quality::Rule,
+) {
+    if let (Some(worst), Some(mean)) = (e.worst, e.mean) {
+        println!("quad eta        worst {worst:.4}, mean {mean:.4}");
+        println!(
+            "poor quads      {} with eta < 0.1, {} with eta < 0.3",
+            e.below_0_1, e.below_0_3
+        );
+    }
+    println!("rule            {rule}");
+}
+
 /// An error in the user's arguments or input files that is not a mesh error.
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]

@@ -1,6 +1,6 @@
 //! `quadrecomb optimum`: the exact optimum (maximum-weight matching of maximum cardinality).
 
-use quadrecomb::quality::{self, CandidateTable};
+use quadrecomb::quality::{self, CandidateTable, ElementQuality};
 use quadrecomb::search::optimum;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -10,8 +10,9 @@ pub struct Args {
     /// Mesh file (.msh) or built-in name.
     mesh: String,
     /// Print one JSON object: mesh, triangles, algo ("optimum"), horizon, seed,
-    /// nodes_expanded and trees (null), quads, triangles_left, recombined_pct, quality and
-    /// time_s as `recombine --json` has them, plus `check` with --check.
+    /// nodes_expanded and trees (null), quads, triangles_left, recombined_pct, quality,
+    /// time_s, worst_eta, mean_eta, quads_eta_below_0_1 / _0_3, min_eta and allow_invalid as
+    /// `recombine --json` has them, plus `check` with --check.
     #[arg(long)]
     json: bool,
     /// Also verify the dual certificate of the matching (feasible duals, complementary
@@ -21,14 +22,18 @@ pub struct Args {
     /// Write the optimal quad mesh (quads and leftover triangles): .msh (MSH 4.1) or .vtu.
     #[arg(short = 'o', long)]
     output: Option<PathBuf>,
+    #[command(flatten)]
+    rule: super::RuleArgs,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     super::check_mesh_output(args.output.as_deref())?;
+    let rule = args.rule.rule()?;
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
-    let table = CandidateTable::build(&mesh);
+    let table = CandidateTable::build(&mesh).restrict(&mesh, rule);
     let (opt, report) = optimum::solve_certified(&mesh, &table, args.check);
     let nt = mesh.num_triangles();
+    let elements = ElementQuality::of_chosen(&table, &opt.chosen);
     let pct = if nt == 0 {
         0.0
     } else {
@@ -61,6 +66,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "nodes_expanded": null,
             "trees": null,
         });
+        super::add_element_fields(&mut v, &elements, rule);
         if let Some(r) = report {
             v["check"] = serde_json::json!({
                 "ok": true,
@@ -77,6 +83,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         println!("triangles left  {}", opt.triangles_left);
         println!("recombined      {pct:.2} %");
         println!("quality         {:.6} (sum of eta)", opt.quality);
+        super::print_element_lines(&elements, rule);
         println!("time            {:.4} s", opt.time_s);
         if let Some(r) = report {
             println!(

@@ -2,7 +2,7 @@
 
 use super::BadInput;
 use quadrecomb::gpu::{Backend, Evaluator};
-use quadrecomb::quality::{self, CandidateTable};
+use quadrecomb::quality::{self, CandidateTable, ElementQuality, Rule};
 use quadrecomb::search::{self, Algo, optimum};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -60,21 +60,30 @@ pub struct Args {
     /// with backend `cpu-twin`) or `--backend gpu` (a `vulkan: ...` backend).
     #[arg(long, value_enum, default_value_t = EtaBackend::Exact)]
     backend: EtaBackend,
+    #[command(flatten)]
+    rule: super::RuleArgs,
 }
 
-/// The candidate table of `mesh` with eta from `backend`, and the evaluator's name.
+/// The candidate table of `mesh` with eta from `backend`, restricted to the pairs `rule`
+/// allows, and the evaluator's name.
 pub fn eta_table(
     mesh: &quadrecomb::mesh::Mesh,
     backend: EtaBackend,
+    rule: Rule,
 ) -> anyhow::Result<(CandidateTable, String)> {
     let ev = match backend {
-        EtaBackend::Exact => return Ok((CandidateTable::build(mesh), "exact".into())),
+        EtaBackend::Exact => {
+            return Ok((
+                CandidateTable::build(mesh).restrict(mesh, rule),
+                "exact".into(),
+            ));
+        }
         EtaBackend::Cpu => Evaluator::cpu_twin(),
         EtaBackend::Gpu => Evaluator::new(Backend::Gpu)?,
     };
     let mut table = CandidateTable::topology_only(mesh);
     ev.fill(&mut [(mesh, &mut table)])?;
-    Ok((table, ev.name().to_string()))
+    Ok((table.restrict(mesh, rule), ev.name().to_string()))
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -90,9 +99,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         eprintln!("note: --horizon is ignored: {name} looks no further than one action");
     }
     super::check_mesh_output(args.output.as_deref())?;
+    let rule = args.rule.rule()?;
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
-    let (table, backend) = eta_table(&mesh, args.backend)?;
+    let (table, backend) = eta_table(&mesh, args.backend, rule)?;
     let out = search::run(&mesh, &table, algo, args.seed);
+    let elements = ElementQuality::of_chosen(&table, &out.chosen);
     let nt = mesh.num_triangles();
     let recombined_pct = 100.0 * (2 * out.quads) as f64 / nt as f64;
     let opt = (!args.no_optimum).then(|| optimum::solve(&mesh, &table));
@@ -125,6 +136,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "decisions": out.decisions,
             "backend": backend,
         });
+        super::add_element_fields(&mut v, &elements, rule);
         if let Some(p) = quality_pct {
             v["quality_pct"] = serde_json::json!(p);
             v["optimum"] = serde_json::json!(opt.as_ref().map(|o| o.quality));
@@ -148,6 +160,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             ),
             _ => println!("quality         {:.4} (sum of eta)", out.quality),
         }
+        super::print_element_lines(&elements, rule);
         println!(
             "nodes expanded  {} ({} look-ahead trees)",
             out.nodes_expanded, out.trees

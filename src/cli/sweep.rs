@@ -43,6 +43,8 @@ pub struct Args {
     /// Who computes the quad qualities.
     #[arg(long, value_enum, default_value_t = Backend::Auto)]
     backend: Backend,
+    #[command(flatten)]
+    rule: super::RuleArgs,
     /// Results directory (default: results/<mesh> for one mesh, results/sweep otherwise;
     /// with --shard I/N, results/<mesh>-shard-I-of-N).
     #[arg(long)]
@@ -135,6 +137,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         seed: args.seed,
         threads: args.threads.unwrap_or(paper.threads),
         backend: args.backend,
+        rule: args.rule.rule()?,
         out: out.clone(),
         resume: args.resume,
         overwrite: args.overwrite,

@@ -92,6 +92,12 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
         trees: out.trees,
         decisions: out.decisions,
         branching_factor,
+        worst_eta: out.elements.worst,
+        mean_eta: out.elements.mean,
+        quads_eta_below_0_1: Some(out.elements.below_0_1),
+        quads_eta_below_0_3: Some(out.elements.below_0_3),
+        min_eta: manifest.spec.min_eta,
+        allow_invalid: manifest.spec.allow_invalid,
         backend: manifest.backend.clone(),
         version: manifest.version.clone(),
     }
@@ -272,6 +278,7 @@ pub(crate) mod tests {
                     quads: 5,
                     triangles_left: 0,
                     time_s: 0.0,
+                    elements: Default::default(),
                 })
                 .collect(),
             spec,
@@ -387,6 +394,7 @@ pub(crate) mod tests {
             trees: 10,
             decisions: 10,
             time_s: 0.5,
+            elements: crate::quality::ElementQuality::of([0.5, 0.9]),
         };
         let r = make_record(&m, &job, out);
         assert_eq!(r.quality_pct, Some(75.0));

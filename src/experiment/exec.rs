@@ -25,6 +25,8 @@ pub struct Outcome {
     pub decisions: u64,
     /// Seconds of search.
     pub time_s: f64,
+    /// Worst and mean eta of the quads, and the poor ones.
+    pub elements: crate::quality::ElementQuality,
 }
 
 /// Runs jobs one after another on one thread, keeping whatever it reuses between them.
@@ -145,6 +147,7 @@ pub(crate) mod tests {
             trees: 5,
             decisions: 5,
             time_s: 0.001 * f64::from(h),
+            elements: crate::quality::ElementQuality::of([0.5, 0.9]),
         }
     }
 

@@ -37,7 +37,7 @@ pub struct Manifest {
 }
 
 /// The configuration that decides the run list and the seeds.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepSpec {
     /// Meshes, in order.
     pub meshes: Vec<MeshEntry>,
@@ -51,6 +51,21 @@ pub struct SweepSpec {
     pub baseline_runs: u32,
     /// Base seed; every run's seed is derived from it.
     pub seed: u64,
+    /// The quad-validity rule's threshold (see [`crate::quality::Rule`]).
+    #[serde(default)]
+    pub min_eta: f64,
+    /// Every pair an action, eta-0 quads included (manifests written before the rule
+    /// existed read as such).
+    #[serde(default = "super::record::paper_literal")]
+    pub allow_invalid: bool,
+}
+
+impl SweepSpec {
+    /// The rule the sweep recombines under.
+    pub fn rule(&self) -> crate::quality::Rule {
+        crate::quality::Rule::new(self.min_eta, self.allow_invalid)
+            .unwrap_or(crate::quality::Rule::AllPairs)
+    }
 }
 
 /// One mesh of a sweep. Two entries are the same mesh when their name, content hash and
@@ -95,6 +110,10 @@ pub struct OptimumEntry {
     pub triangles_left: usize,
     /// Seconds the matching took when it was computed (it may come from the cache since).
     pub time_s: f64,
+    /// Worst and mean eta of the optimum's quads, and the poor ones (absent in manifests
+    /// written before they were recorded).
+    #[serde(default)]
+    pub elements: crate::quality::ElementQuality,
 }
 
 /// The I-th (1-based) of N disjoint slices of a run list.
@@ -258,6 +277,9 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     }
     if a.seed != b.seed {
         return Some(format!("seed {} vs {}", a.seed, b.seed));
+    }
+    if a.rule() != b.rule() {
+        return Some(format!("rule {} vs {}", a.rule(), b.rule()));
     }
     None
 }

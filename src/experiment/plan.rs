@@ -128,6 +128,8 @@ pub(crate) mod tests {
             runs: 5,
             baseline_runs: 2,
             seed: 9,
+            min_eta: 0.0,
+            allow_invalid: false,
         }
     }
 

@@ -53,10 +53,44 @@ pub struct RunRecord {
     /// [`crate::stats::describe::effective_branching_factor`]). `None` for h = 1 (only the root
     /// is expanded, whatever its width), for the other algorithms, and without trees.
     pub branching_factor: Option<f64>,
+    /// The worst quad's eta (`None` without quads, and in records written before it existed).
+    #[serde(default)]
+    pub worst_eta: Option<f64>,
+    /// Mean eta per quad (`quality / quads`; `None` without quads).
+    #[serde(default)]
+    pub mean_eta: Option<f64>,
+    /// Quads with eta < 0.1 (poor elements).
+    #[serde(default)]
+    pub quads_eta_below_0_1: Option<usize>,
+    /// Quads with eta < 0.3.
+    #[serde(default)]
+    pub quads_eta_below_0_3: Option<usize>,
+    /// The quad-validity rule's threshold: only quads with eta > 0 and eta >= `min_eta` are
+    /// made (see [`crate::quality::Rule`]); 0 under `allow_invalid`.
+    #[serde(default)]
+    pub min_eta: f64,
+    /// Every pair was an action, eta-0 quads included (the paper as written). Records made
+    /// before the rule existed were made so, and read as such.
+    #[serde(default = "paper_literal")]
+    pub allow_invalid: bool,
     /// Name of the evaluator that computed eta ("cpu-twin", "vulkan: llvmpipe ...", ...).
     pub backend: String,
     /// Version of quadrecomb that made the record.
     pub version: String,
+}
+
+/// What a field that records the rule reads when absent: the rule of every record and
+/// manifest written before it existed (every pair an action).
+pub(crate) fn paper_literal() -> bool {
+    true
+}
+
+impl RunRecord {
+    /// The rule the run was made under.
+    pub fn rule(&self) -> crate::quality::Rule {
+        crate::quality::Rule::new(self.min_eta, self.allow_invalid)
+            .unwrap_or(crate::quality::Rule::AllPairs)
+    }
 }
 
 /// Identifies a run within a sweep: no two records of a results directory share a key.

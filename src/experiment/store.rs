@@ -144,6 +144,12 @@ pub(crate) mod tests {
             trees: 48,
             decisions: 48,
             branching_factor: Some(1.9),
+            worst_eta: Some(0.2),
+            mean_eta: Some(0.84),
+            quads_eta_below_0_1: Some(0),
+            quads_eta_below_0_3: Some(1),
+            min_eta: 0.0,
+            allow_invalid: false,
             backend: "cpu-twin".into(),
             version: "0.1.0".into(),
         }

@@ -15,7 +15,7 @@ use super::record::ALGO_NAMES;
 use super::seed::{eta_hash, mesh_hash};
 use crate::gpu::{Backend, Evaluator};
 use crate::mesh::Mesh;
-use crate::quality::CandidateTable;
+use crate::quality::{CandidateTable, ElementQuality, Rule};
 use crate::search::{Algo, Searcher};
 
 /// Algorithms of the default sweep (the paper's experiment), in order.
@@ -44,6 +44,8 @@ pub struct SweepConfig {
     pub threads: usize,
     /// Who computes eta.
     pub backend: Backend,
+    /// Which pairs may be merged (valid quads by default).
+    pub rule: Rule,
     /// Results directory.
     pub out: PathBuf,
     /// Continue the sweep in `out`.
@@ -68,6 +70,7 @@ impl SweepConfig {
             seed: DEFAULT_SEED,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
             backend: Backend::Auto,
+            rule: Rule::default(),
             out: PathBuf::from("results/borouchaki"),
             resume: false,
             overwrite: false,
@@ -195,6 +198,9 @@ pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
             meshes.iter().zip(tables.iter_mut()).collect();
         evaluator.fill(&mut jobs)?;
     }
+    let tables: Vec<CandidateTable> = (meshes.iter().zip(tables))
+        .map(|(mesh, table)| table.restrict(mesh, config.rule))
+        .collect();
     let mut optimum = Vec::new();
     for ((mesh, table), entry) in meshes.iter().zip(&tables).zip(&entries) {
         optimum.push(cached_optimum(&config.out, mesh, table, entry)?);
@@ -212,6 +218,8 @@ pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
             runs: config.runs,
             baseline_runs: config.baseline_runs,
             seed: config.seed,
+            min_eta: config.rule.min_eta(),
+            allow_invalid: config.rule.allows_invalid(),
         },
         backend: evaluator.name().to_string(),
         backend_requested: config.backend.to_string(),
@@ -241,7 +249,10 @@ pub fn cached_optimum(
     let eta = eta_hash(&table.eta);
     if let Ok(text) = std::fs::read_to_string(&path) {
         if let Ok(cached) = serde_json::from_str::<CachedOptimum>(&text) {
-            if cached.optimum.mesh_hash == entry.hash && cached.optimum.eta_hash == eta {
+            // Caches written before the element figures were recorded lack them.
+            let complete = cached.optimum.quads == 0 || cached.optimum.elements.worst.is_some();
+            if cached.optimum.mesh_hash == entry.hash && cached.optimum.eta_hash == eta && complete
+            {
                 return Ok(OptimumEntry {
                     mesh: entry.name.clone(),
                     // JSON parsing of floats may be off by an ulp: restore the exact value,
@@ -261,6 +272,7 @@ pub fn cached_optimum(
         quads: opt.quads,
         triangles_left: opt.triangles_left,
         time_s: opt.time_s,
+        elements: ElementQuality::of_chosen(table, &opt.chosen),
     };
     std::fs::create_dir_all(&dir).map_err(|e| ExperimentError::io(&dir, e))?;
     let cached = CachedOptimum {
@@ -324,6 +336,7 @@ impl Worker for SearchWorker<'_> {
                 trees: 0,
                 decisions: o.quads as u64,
                 time_s: o.time_s,
+                elements: o.elements,
             });
         }
         let algo = Algo::from_name(&job.algo, job.horizon.unwrap_or(1))
@@ -333,6 +346,7 @@ impl Worker for SearchWorker<'_> {
             .get_or_insert_with(|| Searcher::new(&f.meshes[job.mesh], &f.tables[job.mesh]));
         let out = searcher.run(algo, job.seed);
         Ok(Outcome {
+            elements: ElementQuality::of_chosen(&f.tables[job.mesh], &out.chosen),
             quads: out.quads,
             triangles_left: out.triangles_left,
             quality: out.quality,

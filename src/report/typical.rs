@@ -187,6 +187,11 @@ fn prepare(results: &Results, run: &Run) -> Result<Prepared, String> {
         format!("the f64 reference (the sweep used {})", run.backend),
         CandidateTable::build(&mesh),
     ));
+    // The pairs the run's rule allowed: the manifest's eta hash is over those.
+    let rule = run.rule();
+    let mut tried: Vec<(String, CandidateTable)> = (tried.into_iter())
+        .map(|(what, t)| (what, t.restrict(&mesh, rule)))
+        .collect();
     let pick = match &want {
         Some(h) => tried.iter().position(|(_, t)| &eta_hash(&t.eta) == h),
         None => None,

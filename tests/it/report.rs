@@ -250,6 +250,12 @@ fn record(
         trees: decisions,
         decisions,
         branching_factor: horizon.filter(|&h| h >= 2).map(|_| 1.5),
+        worst_eta: Some(0.05),
+        mean_eta: Some(quality_pct * 9.5 / quads as f64),
+        quads_eta_below_0_1: Some(2),
+        quads_eta_below_0_3: Some(9),
+        min_eta: 0.0,
+        allow_invalid: false,
         backend: "cpu-twin".to_string(),
         version: "0.1.0".to_string(),
     }
@@ -308,6 +314,8 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
             runs,
             baseline_runs: runs,
             seed: SEED,
+            min_eta: 0.0,
+            allow_invalid: false,
         },
         backend: "cpu-twin".into(),
         backend_requested: "cpu".into(),
@@ -319,6 +327,7 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
             quads: 1052,
             triangles_left: 0,
             time_s: 0.5,
+            elements: Default::default(),
         }],
         shard: None,
         threads: 2,
@@ -704,6 +713,7 @@ fn real_sphere_dir(dir: &Path, tamper: f64) {
     Evaluator::cpu_twin()
         .fill(&mut [(&mesh, &mut table)])
         .unwrap();
+    let table = table.restrict(&mesh, quadrecomb::quality::Rule::default());
     let hash = mesh_hash(&mesh);
     let mut lines = Vec::new();
     for (algo, h) in [
@@ -739,6 +749,12 @@ fn real_sphere_dir(dir: &Path, tamper: f64) {
                     trees: out.trees,
                     decisions: out.decisions,
                     branching_factor: None,
+                    worst_eta: None,
+                    mean_eta: None,
+                    quads_eta_below_0_1: None,
+                    quads_eta_below_0_3: None,
+                    min_eta: 0.0,
+                    allow_invalid: false,
                     backend: "cpu-twin".into(),
                     version: "0.1.0".into(),
                 }

@@ -18,6 +18,12 @@ const CASES: &[(&str, &[&str], &str, u32)] = &[
         2,
     ),
     ("results/sphere", &["selective", "greedy"], "1..3", 3),
+    (
+        "results/borouchaki-allow-invalid",
+        &["selective", "greedy"],
+        "1..2",
+        2,
+    ),
 ];
 
 fn committed(dir: &Path) -> Option<(Manifest, Vec<RunRecord>)> {
@@ -86,6 +92,13 @@ fn a_reduced_sweep_reproduces_the_committed_records() {
             "--out",
             out.to_str().unwrap(),
         ]);
+        // The rule the committed sweep recombined under.
+        let min_eta = manifest.spec.min_eta.to_string();
+        if manifest.spec.allow_invalid {
+            args.push("--allow-invalid");
+        } else {
+            args.extend_from_slice(&["--min-eta", &min_eta]);
+        }
         let output = run_in(tmp.path(), &args);
         assert!(
             output.status.success(),

@@ -182,7 +182,7 @@ impl State<'_> {
         }
         // The dense dual graph, not the triangle records: a search streams through many
         // triangles and reads only their neighbours (a quarter of the bytes).
-        let nb = &self.mesh.topology.neighbours[..];
+        let nb = &self.dual[..];
         loop {
             // The verdict can only change when a search runs dry or two groups meet.
             let mut event = false;

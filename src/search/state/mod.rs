@@ -192,6 +192,9 @@ pub struct State<'a> {
     cand: Vec<CandRecord>,
     /// Per triangle: its ring of vertices, neighbours and candidates.
     tri: Vec<TriRecord>,
+    /// The candidates' dual graph as a dense array (the triangle across each side through a
+    /// candidate, or NONE), which the lockstep searches stream through.
+    dual: Vec<[u32; 3]>,
     /// Candidates whose quad has vertex `v` (CSR).
     vc_start: Vec<u32>,
     vc_list: Vec<u32>,
@@ -270,7 +273,11 @@ impl<'a> State<'a> {
         let nt = mesh.num_triangles();
         let nv = mesh.vertices.len();
         let m = table.len();
-        let nb = &mesh.topology.neighbours;
+        // The dual graph of the candidates: the mesh's, less the pairs the rule dropped
+        // (those sides are boundaries for the criterion, like a surface's).
+        let dual = table.dual_graph();
+        let (polder, polder_size) = CandidateTable::components(&dual);
+        let nb = &dual;
         let cand_nb: Vec<[u32; 4]> = (0..m)
             .map(|c| {
                 let [t0, t1] = table.pairs[c];
@@ -402,6 +409,7 @@ impl<'a> State<'a> {
             closed,
             cand,
             tri,
+            dual,
             vc_start,
             vc_list,
             alive: vec![true; nt],
@@ -412,8 +420,8 @@ impl<'a> State<'a> {
             base_cert_init: 0,
             ver: 0,
             dead_count: vec![0; nv],
-            polder: mesh.topology.component.clone(),
-            polder_size: mesh.topology.component_sizes.clone(),
+            polder,
+            polder_size,
             watch: vec![Vec::new(); nt],
             dsu_parent: (0..nv as u32).collect(),
             dsu_size: vec![1; nv],
@@ -451,7 +459,7 @@ impl<'a> State<'a> {
         // boundaries: dual sides without a neighbour) and input quads.
         for (t, tri) in mesh.triangles.iter().enumerate() {
             for i in 0..3 {
-                if nb[t][i] == NONE {
+                if st.dual[t][i] == NONE {
                     st.union(tri[i], tri[(i + 1) % 3]);
                 }
             }
@@ -1252,7 +1260,8 @@ impl<'a> State<'a> {
 /// neighbour of the pair, same rule: at most one odd part): the reference the fast state is
 /// tested against. `alive[t]` says which triangles remain.
 pub fn naive_allowed(mesh: &Mesh, table: &CandidateTable, alive: &[bool]) -> Vec<bool> {
-    let nb = &mesh.topology.neighbours;
+    debug_assert_eq!(mesh.num_triangles(), alive.len());
+    let nb = &table.dual_graph();
     let nt = alive.len();
     let mut stack = Vec::new();
     let mut mark = vec![0u32; nt];

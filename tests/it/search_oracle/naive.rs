@@ -3,9 +3,9 @@
 //!
 //! The rule (issue 9, Definition 2 generalised to odd polders):
 //! - *remaining* triangles are those not yet recombined;
-//! - the *polder* P of an action (t, t') is the connected component, in the dual graph
-//!   (`mesh.topology.neighbours`, which links only triangles of the same surface) restricted to
-//!   remaining triangles, that holds t and t';
+//! - the *polder* P of an action (t, t') is the connected component, in the graph of the
+//!   candidate pairs (the table's `pairs`: neighbouring triangles of the same surface, less the
+//!   pairs the quad-validity rule dropped) restricted to remaining triangles, that holds t and t';
 //! - removing t and t' leaves P \ {t, t'}, which splits into *parts*: the connected components
 //!   of the dual graph restricted to P \ {t, t'};
 //! - the action is *allowed* iff it does not increase the number of odd polders: if |P| is
@@ -60,8 +60,16 @@ impl Verdicts {
 impl Naive {
     /// Every triangle remaining, nothing applied.
     pub fn new(mesh: &Mesh, table: &CandidateTable) -> Naive {
+        // The graph of the candidate pairs, from the pairs alone.
+        let mut neighbours = vec![[NONE; 3]; mesh.num_triangles()];
+        for &[a, b] in &table.pairs {
+            for (x, y) in [(a, b), (b, a)] {
+                let slot = neighbours[x as usize].iter().position(|&u| u == NONE);
+                neighbours[x as usize][slot.expect("at most three pairs per triangle")] = y;
+            }
+        }
         Naive {
-            neighbours: mesh.topology.neighbours.clone(),
+            neighbours,
             pairs: table.pairs.clone(),
             remaining: vec![true; mesh.num_triangles()],
             log: Vec::new(),

@@ -7,8 +7,10 @@ use crate::util::SEED;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 use quadrecomb::mesh::Mesh;
-use quadrecomb::quality::CandidateTable;
+use quadrecomb::quality::{CandidateTable, Rule};
 use quadrecomb::search::state::State;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 impl Subject for State<'_> {
     fn apply(&mut self, c: u32) {
@@ -45,14 +47,26 @@ fn check_mesh(
     seeds: std::ops::Range<u64>,
     config: WalkConfig,
 ) -> WalkStats {
-    let table = CandidateTable::build(mesh);
+    check_table(name, mesh, &CandidateTable::build(mesh), seeds, config)
+}
+
+/// [`check_mesh`] with the candidates of `table` (a restricted one: fewer pairs).
+fn check_table(
+    name: &str,
+    mesh: &Mesh,
+    table: &CandidateTable,
+    seeds: std::ops::Range<u64>,
+    config: WalkConfig,
+) -> WalkStats {
+    let table = table.clone();
     let mut total = WalkStats::default();
     for s in seeds {
         let seed = SEED ^ s;
         let mut state = State::new(mesh, &table);
+        let any_allowed = !state.allowed_actions().is_empty();
         let stats =
             walk(name, mesh, &table, &mut state, seed, config).unwrap_or_else(|e| panic!("{e}"));
-        if !table.is_empty() {
+        if any_allowed {
             assert!(stats.applies > 0, "{name}: the walk applied nothing");
         }
         total.checks += stats.checks;
@@ -107,6 +121,43 @@ fn state_matches_oracle_on_sample_meshes() {
         let stats = check_mesh(&name, &mesh, 0..1, WalkConfig::default());
         total.checks += stats.checks;
     }
+    assert!(total.checks > 1000, "{total:?}");
+}
+
+#[test]
+fn state_matches_oracle_on_restricted_candidates() {
+    // The valid-quad rule cuts the dual graph where a pair makes no valid quad: polders are
+    // the components of the remaining pairs. Thresholds that drop about a tenth to a half of
+    // the pairs, and random cuts that no geometry would make.
+    let mut total = WalkStats::default();
+    let mut dropped = 0;
+    for (k, (name, mesh)) in sample_meshes(SEED ^ 0x21).into_iter().enumerate() {
+        let full = CandidateTable::build(&mesh);
+        for min_eta in [0.0, 0.5, 0.8] {
+            let table = full.clone().restrict(&mesh, Rule::Valid { min_eta });
+            dropped += full.len() - table.len();
+            let stats = check_table(
+                &format!("{name}, eta >= {min_eta}"),
+                &mesh,
+                &table,
+                0..1,
+                WalkConfig::default(),
+            );
+            total.checks += stats.checks;
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ k as u64);
+        let keep: Vec<bool> = (0..full.len()).map(|_| rng.random_bool(0.7)).collect();
+        let table = full.retain(&keep);
+        let stats = check_table(
+            &format!("{name}, 70 % of the pairs"),
+            &mesh,
+            &table,
+            0..2,
+            WalkConfig::default(),
+        );
+        total.checks += stats.checks;
+    }
+    assert!(dropped > 500, "the thresholds dropped only {dropped} pairs");
     assert!(total.checks > 1000, "{total:?}");
 }
 

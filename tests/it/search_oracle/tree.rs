@@ -9,7 +9,7 @@ use super::sample_meshes;
 use super::walk::compare;
 use crate::util::SEED;
 use quadrecomb::mesh::{Mesh, NONE};
-use quadrecomb::quality::CandidateTable;
+use quadrecomb::quality::{CandidateTable, Rule};
 use quadrecomb::search::state::State;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -150,7 +150,18 @@ fn check_node(
 /// (allowed actions, as the trees push) with every query checked after each step, then a
 /// full comparison of the base state (which the tree must leave exact and untouched).
 fn tree_walk(name: &str, mesh: &Mesh, seed: u64, max_depth: usize) -> Result<u64, String> {
-    let table = CandidateTable::build(mesh);
+    tree_walk_on(name, mesh, &CandidateTable::build(mesh), seed, max_depth)
+}
+
+/// [`tree_walk`] with the candidates of `table` (a restricted one: fewer pairs).
+fn tree_walk_on(
+    name: &str,
+    mesh: &Mesh,
+    table: &CandidateTable,
+    seed: u64,
+    max_depth: usize,
+) -> Result<u64, String> {
+    let table = table.clone();
     let mut state = State::new(mesh, &table);
     let mut oracle = Naive::new(mesh, &table);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -237,4 +248,16 @@ fn tree_layer_matches_oracle() {
             tree_walk(&format!("{spec:?}"), &mesh, SEED ^ s, 12).unwrap_or_else(|e| panic!("{e}"));
     }
     assert!(queries > 10_000, "{queries} tree queries");
+}
+
+#[test]
+fn tree_layer_matches_oracle_on_restricted_candidates() {
+    // Polders under the valid-quad rule: the dual graph less the pairs dropped.
+    let mut queries = 0;
+    for (name, mesh) in sample_meshes(SEED ^ 0x7E5) {
+        let table = CandidateTable::build(&mesh).restrict(&mesh, Rule::Valid { min_eta: 0.6 });
+        queries += tree_walk_on(&format!("{name}, eta >= 0.6"), &mesh, &table, SEED, 8)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    assert!(queries > 5_000, "{queries} tree queries");
 }
