@@ -4,7 +4,8 @@
 //! summary.csv is long-format: one row per (mesh, algo, horizon, metric) with the columns
 //! `mesh,algo,horizon,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers`
 //! (horizon empty for algorithms without one). Metrics: `quality_pct`, `recombined_pct`,
-//! `time_s`, `nodes_expanded`, `branching_factor` (the last only where defined).
+//! `time_s`, `nodes_expanded`, `branching_factor`, `mean_eta`, `worst_eta`,
+//! `quads_eta_below_0_1`, `quads_eta_below_0_3` (each only where its runs record it).
 //! summary.json holds the same groups with the outlier values, and the growth fits.
 
 use std::collections::BTreeMap;
@@ -28,6 +29,10 @@ pub const METRICS: &[&str] = &[
     "time_s",
     "nodes_expanded",
     "branching_factor",
+    "mean_eta",
+    "worst_eta",
+    "quads_eta_below_0_1",
+    "quads_eta_below_0_3",
 ];
 
 /// Statistics of one (mesh, algo, horizon) configuration.
@@ -53,6 +58,18 @@ pub struct Group {
     pub branching_factor: Option<BoxStats>,
     /// Mean of the runs' effective branching factors.
     pub mean_branching_factor: Option<f64>,
+    /// Mean eta per quad of each run.
+    #[serde(default)]
+    pub mean_eta: Option<BoxStats>,
+    /// The worst quad's eta of each run.
+    #[serde(default)]
+    pub worst_eta: Option<BoxStats>,
+    /// Quads with eta < 0.1 per run.
+    #[serde(default)]
+    pub quads_eta_below_0_1: Option<BoxStats>,
+    /// Quads with eta < 0.3 per run.
+    #[serde(default)]
+    pub quads_eta_below_0_3: Option<BoxStats>,
 }
 
 /// Growth of time with horizon for one (mesh, algo).
@@ -107,6 +124,14 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
                 nodes_expanded: BoxStats::of(&col(&|r| Some(r.nodes_expanded as f64))),
                 mean_branching_factor: (!bf.is_empty()).then(|| crate::stats::describe::mean(&bf)),
                 branching_factor: BoxStats::of(&bf),
+                mean_eta: BoxStats::of(&col(&|r| r.mean_eta)),
+                worst_eta: BoxStats::of(&col(&|r| r.worst_eta)),
+                quads_eta_below_0_1: BoxStats::of(&col(&|r| {
+                    r.quads_eta_below_0_1.map(|n| n as f64)
+                })),
+                quads_eta_below_0_3: BoxStats::of(&col(&|r| {
+                    r.quads_eta_below_0_3.map(|n| n as f64)
+                })),
             }
         })
         .collect();
@@ -148,6 +173,10 @@ impl Group {
             "time_s" => self.time_s.as_ref(),
             "nodes_expanded" => self.nodes_expanded.as_ref(),
             "branching_factor" => self.branching_factor.as_ref(),
+            "mean_eta" => self.mean_eta.as_ref(),
+            "worst_eta" => self.worst_eta.as_ref(),
+            "quads_eta_below_0_1" => self.quads_eta_below_0_1.as_ref(),
+            "quads_eta_below_0_3" => self.quads_eta_below_0_3.as_ref(),
             _ => None,
         }
     }

@@ -181,6 +181,13 @@ fn overview(doc: &mut Document, results: &Results) {
         versions.join(", "),
         backends.join(", "),
     ));
+    let mut rules: Vec<String> = runs.iter().map(|r| r.rule().to_string()).collect();
+    rules.sort_unstable();
+    rules.dedup();
+    doc.para(format!(
+        "Rule: {} (which pairs of triangles may be merged; `--min-eta`, `--allow-invalid`).",
+        rules.join("; ")
+    ));
     if let Some(m) = &results.manifest {
         let machine = |m: &crate::experiment::manifest::Machine| {
             format!("{} ({} logical cores), {}", m.cpu, m.cores, m.os)
@@ -325,6 +332,7 @@ fn mesh_section(
          decisions are unchanged), and its time grows more slowly with the horizon.",
     );
 
+    element_table(doc, &configs);
     paper_beside(doc, mesh, &configs);
     box_plots(doc, mesh, &configs)?;
     if opts.pictures {
@@ -339,6 +347,55 @@ fn mesh_section(
     }
     family_blocks(doc, &families);
     Ok(())
+}
+
+/// The element quality of each configuration beside its sum: a high sum with many
+/// triangles left, or with near-degenerate quads, is not a better mesh.
+fn element_table(doc: &mut Document, configs: &[(&Config, &[Run])]) {
+    if configs.iter().all(|(_, runs)| runs[0].mean_eta.is_none()) {
+        return;
+    }
+    doc.heading(3, "Element quality (medians)");
+    let count = |f: fn(&Run) -> Option<usize>| move |r: &Run| f(r).map(|n| n as f64);
+    let rows: Vec<Vec<String>> = configs
+        .iter()
+        .map(|(c, runs)| {
+            vec![
+                c.algo.clone(),
+                c.horizon.map_or("–".into(), |h| h.to_string()),
+                fmt_opt(median_opt(runs, |r| r.mean_eta), 4),
+                fmt_opt(median_opt(runs, |r| r.worst_eta), 4),
+                fmt_opt(median_opt(runs, count(|r| r.quads_eta_below_0_1)), 1),
+                fmt_opt(median_opt(runs, count(|r| r.quads_eta_below_0_3)), 1),
+                format!(
+                    "{}",
+                    median(
+                        &runs
+                            .iter()
+                            .map(|r| r.triangles_left as f64)
+                            .collect::<Vec<_>>()
+                    )
+                ),
+            ]
+        })
+        .collect();
+    doc.table(
+        [
+            "algorithm",
+            "horizon",
+            "mean eta per quad",
+            "worst eta",
+            "quads with eta < 0.1",
+            "quads with eta < 0.3",
+            "triangles left",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows,
+    );
+    doc.para(
+        "The quality percentage above sums eta over the quads made; these say what those quads          are: the mean eta per quad, the worst quad, and how many are poor, beside the triangles          left unrecombined (which count nothing in the sum). A policy that makes fewer quads          can reach a similar sum with a higher mean and more triangles left: compare the          columns together.",
+    );
 }
 
 /// Summary sentences and a table per family.

@@ -10,3 +10,4 @@ mod runner;
 mod search;
 mod search_oracle;
 mod util;
+mod valid_output;
