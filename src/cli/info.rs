@@ -1,7 +1,7 @@
 //! `quadrecomb info`: a mesh's size, topology and candidate quad qualities, with parse time.
 
 use quadrecomb::mesh;
-use quadrecomb::quality::{self, CandidateTable};
+use quadrecomb::quality::{self, CandidateTable, Rule};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -37,6 +37,9 @@ struct Info {
     odd_components: usize,
     boundary_edges: usize,
     candidate_pairs: usize,
+    /// Candidate pairs whose quad is strictly convex (eta > 0): the actions under the
+    /// default rule.
+    valid_pairs: usize,
     reoriented_triangles: usize,
     ignored_elements: usize,
     /// The ignored elements per Gmsh type: "N Name (type T)", in increasing type.
@@ -124,6 +127,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             odd_components: 0,
             boundary_edges: quad_boundary_edges(&data.quads),
             candidate_pairs: 0,
+            valid_pairs: 0,
             reoriented_triangles: 0,
             ignored_elements,
             ignored_by_type,
@@ -157,6 +161,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         odd_components: topo.component_sizes.iter().filter(|&&s| s % 2 == 1).count(),
         boundary_edges: topo.boundary_edges.len(),
         candidate_pairs: table.len(),
+        valid_pairs: table
+            .eta
+            .iter()
+            .filter(|&&e| Rule::default().allows(e))
+            .count(),
         reoriented_triangles: m.reoriented,
         ignored_elements,
         ignored_by_type,
@@ -209,7 +218,12 @@ fn text(i: &Info) -> String {
         i.odd_components
     );
     wln!(s, "boundary edges:       {}", i.boundary_edges);
-    wln!(s, "candidate pairs:      {}", i.candidate_pairs);
+    wln!(
+        s,
+        "candidate pairs:      {} ({} make a valid quad, eta > 0)",
+        i.candidate_pairs,
+        i.valid_pairs
+    );
     wln!(s, "reoriented triangles: {}", i.reoriented_triangles);
     if i.ignored_elements > 0 {
         wln!(

@@ -267,7 +267,8 @@ mod tests {
         let upper = s.growth[0].upper.as_ref().unwrap();
         assert_eq!((upper.h_min, upper.h_max), (3, 4));
         let csv = to_csv(&s);
-        assert_eq!(csv.lines().count(), 1 + 4 + 4 * 5);
+        // 4 metrics and 4 element-quality ones per group, plus the tree groups' branching factor.
+        assert_eq!(csv.lines().count(), 1 + 8 + 4 * 9);
         assert!(csv.contains("m,selective,2,quality_pct,5,94,"), "{csv}");
     }
 }
