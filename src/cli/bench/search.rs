@@ -22,6 +22,8 @@ pub struct Args {
     /// into a maze where most actions split a polder).
     #[arg(long, default_value_t = 2)]
     max_uniform: u32,
+    #[command(flatten)]
+    rule: crate::cli::RuleArgs,
 }
 
 /// CPU time of this thread in seconds (Linux schedstat), when available: on a loaded
@@ -111,9 +113,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.runs == 0 {
         return Err(BadInput("--runs must be at least 1".into()).into());
     }
+    let rule = args.rule.rule()?;
     println!(
         "Per run (median over seeds 0..{}): wall and thread-CPU milliseconds, quality as % of \
-         the exact optimum, % of triangles recombined, nodes expanded per decision.\n",
+         the exact optimum, % of triangles recombined, nodes expanded per decision. Rule: {rule}.\n",
         args.runs
     );
     println!(
@@ -121,7 +124,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     );
     println!("|---|---|---:|---:|---:|---:|---:|---:|");
     let b = mesh::load("borouchaki")?;
-    let bt = CandidateTable::build(&b);
+    let bt = CandidateTable::build(&b).restrict(&b, rule);
     let bopt = optimum::solve(&b, &bt).quality;
     let mut s = Searcher::new(&b, &bt);
     let nb = b.num_triangles();
@@ -154,7 +157,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     drop(s);
     let sp = mesh::load("sphere")?;
-    let st = CandidateTable::build(&sp);
+    let st = CandidateTable::build(&sp).restrict(&sp, rule);
     let sopt = optimum::solve(&sp, &st).quality;
     let mut s = Searcher::new(&sp, &st);
     let ns = sp.num_triangles();
@@ -196,7 +199,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         };
         mesh::order::spatial(&mut data);
         let g = mesh::Mesh::new(data)?;
-        let t = CandidateTable::build(&g);
+        let t = CandidateTable::build(&g).restrict(&g, rule);
         grids.push((g, t));
         n *= 10;
     }
