@@ -14,8 +14,11 @@
 //! [`ReadError::Io`] of kind `InvalidData` whose message starts with `byte offset N:`). Content errors found by [`Mesh::new`] come back as [`ReadError::Mesh`]
 //! with the file's node and element tags.
 
+mod model;
 mod read;
 mod write;
+
+pub use model::{Element, Entity, Model, PhysicalName};
 
 use super::{Mesh, MeshData, MeshError, ReadError, Recombined};
 use std::fmt;
