@@ -1243,7 +1243,13 @@ struct NodeBlock41 {
 /// Records the entity and parametric coordinates (`extra` of `params`) of a node.
 fn classify_node(c: &mut Content, b: &NodeBlock41, params: [f64; 3]) {
     c.model.node_entity.push(Some(b.entity));
-    c.model.node_param.push((b.extra > 0).then_some(params));
+    c.model.node_param.push(parametric(b.extra, params));
+}
+
+/// The first `n` of `u` as a node's parametric coordinates: none if `n` is 0 or one is not
+/// finite (then they are not written back).
+fn parametric(n: usize, u: [f64; 3]) -> Option<[f64; 3]> {
+    (n > 0 && u.iter().all(|x| x.is_finite())).then_some(u)
 }
 
 /// The tags, then coordinates (with their parametric ones), of an ASCII node block.
@@ -1379,7 +1385,7 @@ fn parametric_nodes22(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
         c.node_tags.push(tag as u64);
         c.data.vertices.push(x);
         c.model.node_entity.push(Some((dim as u8, entity)));
-        c.model.node_param.push((params > 0).then_some(u));
+        c.model.node_param.push(parametric(params, u));
     }
     Ok(())
 }
