@@ -7,7 +7,7 @@
 //! quads (type 3) are read with their element tag and geometric entity (surface) tag; points,
 //! lines and other element types are counted in [`MshFile::ignored_elements`] and not
 //! recombined. The file's [`Model`] (physical names, entities, node classification, points
-//! and lines) is kept in [`MeshData::model`] and written back by [`write`].
+//! and lines) is kept in [`MeshData::model`] and written back by [`write()`].
 //! Binary files must be little-endian (checked with the format's int `1` marker) with 8-byte
 //! `size_t`.
 //!
