@@ -40,6 +40,10 @@ pub struct Mesh {
     pub quad_surface: Vec<i32>,
     /// Number of triangles whose orientation was flipped to make their surface consistent.
     pub reoriented: usize,
+    /// The Gmsh model of the input file (physical groups, entities, node classification,
+    /// point and line elements), which the MSH writer writes back; `None` for generated
+    /// meshes.
+    pub model: Option<Box<msh::Model>>,
     /// Edges, dual graph, boundary and components.
     pub topology: Topology,
 }
@@ -60,6 +64,9 @@ pub struct MeshData {
     pub quad_ids: Vec<u64>,
     /// Surface tag of each quad; empty means surface 1.
     pub quad_surface: Vec<i32>,
+    /// The Gmsh model of a file (see [`msh::Model`]); its per-vertex arrays follow
+    /// `vertices`. `None` for generated meshes.
+    pub model: Option<Box<msh::Model>>,
 }
 
 impl MeshData {

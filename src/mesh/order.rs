@@ -4,7 +4,8 @@
 //! indices apart), which scatters every per-triangle and per-candidate array the searches
 //! touch around one quad over as many cache lines; in this order neighbours are mostly
 //! adjacent in memory. Node and element tags are kept, so written files carry the input's
-//! tags.
+//! tags, and a file's model (node classification, point and line elements) follows the new
+//! vertex order.
 
 use super::MeshData;
 
@@ -82,6 +83,9 @@ pub fn spatial(data: &mut MeshData) {
     }
     data.vertices = from.iter().map(|&v| data.vertices[v as usize]).collect();
     data.vertex_ids = from.iter().map(|&v| data.vertex_ids[v as usize]).collect();
+    if let Some(model) = &mut data.model {
+        model.renumber(&from, &new_index);
+    }
 }
 
 #[cfg(test)]

@@ -268,6 +268,7 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
         quads: data.quads,
         quad_surface: data.quad_surface,
         reoriented,
+        model: data.model,
         topology: Topology {
             edges,
             triangle_edges,

@@ -93,3 +93,34 @@ gmsh.model.mesh.partition(2)
 write("box_parts_41_ascii.msh", 4.1, 0)
 write("box_parts_41_bin.msh", 4.1, 1)
 gmsh.finalize()
+
+# A channel of two surfaces with named physical groups, for writing back the model
+# (tests/it/model.rs): the unit square "left" beside the square [1, 2] x [0, 1] minus a
+# disk, "right"; the curves "inlet" (x = 0), "outlet" (x = 2) and "walls" (top, bottom and
+# the hole). Only physical elements are saved (Gmsh's default): the surfaces' triangles,
+# the lines of the named curves and no points; the nodes of the common curve x = 1 and of
+# the corner points are classified on them all the same.
+start("channel")
+occ = gmsh.model.occ
+left = occ.addRectangle(0, 0, 0, 1, 1)
+right = occ.addRectangle(1, 0, 0, 1, 1)
+occ.cut([(2, right)], [(2, occ.addDisk(1.5, 0.5, 0, 0.2, 0.2))])
+occ.fragment([(2, left)], [e for e in occ.getEntities(2) if e[1] != left])
+mesh(0.12)
+groups = {"inlet": [], "outlet": [], "walls": []}
+for _, c in gmsh.model.getEntities(1):
+    x, _, _ = occ.getCenterOfMass(1, c)
+    if abs(x) < 1e-9:
+        groups["inlet"].append(c)
+    elif abs(x - 2) < 1e-9:
+        groups["outlet"].append(c)
+    elif abs(x - 1) > 1e-9:
+        groups["walls"].append(c)
+for name, curves in groups.items():
+    gmsh.model.addPhysicalGroup(1, curves, name=name)
+for _, s in gmsh.model.getEntities(2):
+    x, _, _ = occ.getCenterOfMass(2, s)
+    gmsh.model.addPhysicalGroup(2, [s], name="left" if x < 1 else "right")
+write("channel_41_ascii.msh", 4.1, 0)
+write("channel_22_ascii.msh", 2.2, 0)
+gmsh.finalize()

@@ -3,6 +3,7 @@
 mod gpu;
 mod io;
 mod meshes;
+mod model;
 mod optimum;
 mod report;
 mod results;

@@ -5,7 +5,9 @@
 //! lines): one pass over the bytes, no allocation per line, node tags mapped to dense indices
 //! (a vector when tags are compact, a hash map when they are sparse). Triangles (type 2) and
 //! quads (type 3) are read with their element tag and geometric entity (surface) tag; points,
-//! lines and other element types are counted in [`MshFile::ignored_elements`] and skipped.
+//! lines and other element types are counted in [`MshFile::ignored_elements`] and not
+//! recombined. The file's [`Model`] (physical names, entities, node classification, points
+//! and lines) is kept in [`MeshData::model`] and written back by [`write()`].
 //! Binary files must be little-endian (checked with the format's int `1` marker) with 8-byte
 //! `size_t`.
 //!
@@ -14,8 +16,11 @@
 //! [`ReadError::Io`] of kind `InvalidData` whose message starts with `byte offset N:`). Content errors found by [`Mesh::new`] come back as [`ReadError::Mesh`]
 //! with the file's node and element tags.
 
+mod model;
 mod read;
 mod write;
+
+pub use model::{Element, Entity, Model, PhysicalName};
 
 use super::{Mesh, MeshData, MeshError, ReadError, Recombined};
 use std::fmt;
@@ -157,7 +162,11 @@ pub fn read_bytes(name: &str, bytes: &[u8]) -> Result<Mesh, ReadError> {
 
 /// Writes `mesh` recombined as `rec` to `path` as MSH 4.1 ASCII: per surface entity, one block
 /// of quads (recombined and input quads, type 3) and one of leftover triangles (type 2), with
-/// `$Entities` so that Gmsh opens it. Node tags are the mesh's; elements are numbered from 1.
+/// `$Entities` so that Gmsh opens it. A mesh read from a Gmsh file is written on its
+/// [`Model`]: `$PhysicalNames`, its entities, every node on the entity it was classified on
+/// (with its parametric coordinates), its point and line elements first; a mesh without one
+/// (generated) has one surface entity per surface tag, each node on the first surface that
+/// uses it. Node tags are the mesh's; elements are numbered from 1.
 pub fn write(path: &Path, mesh: &Mesh, rec: &Recombined) -> Result<(), ReadError> {
     let io = |source| ReadError::Io {
         path: path.to_path_buf(),

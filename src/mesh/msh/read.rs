@@ -5,9 +5,10 @@
 //! their header carry the byte offset (as [`ReadError::Io`] of kind `InvalidData`, whose
 //! message names the offset).
 
+use super::model::{Element, Entity, Model, PhysicalName};
 use super::{MshFile, MshVersion, SkippedElements};
 use crate::mesh::{MeshData, ReadError};
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::path::Path;
 
 /// Gmsh's element types (4.15, as its MSH reader knows them: `MElement::getInfoMSH`):
@@ -593,6 +594,132 @@ struct Content {
     /// interfaces between volume partitions. Their triangles lie inside the volume, not on
     /// a model surface, and are skipped.
     interfaces: HashSet<i64>,
+    /// The model, as the file gives it (see [`ModelParts::finish`]).
+    model: ModelParts,
+}
+
+/// The parts of the file's model, collected while reading.
+#[derive(Default)]
+struct ModelParts {
+    physical_names: Vec<PhysicalName>,
+    /// `$Entities` (4.1), if the file has it.
+    entities: Option<Vec<Entity>>,
+    /// The entity of each node as the file gives it, aligned with `Content::node_tags`
+    /// (`None`: not given, MSH 2.2 `$Nodes`).
+    node_entity: Vec<Option<(u8, i32)>>,
+    node_param: Vec<Option<[f64; 3]>>,
+    /// Point and line elements (on the file's entities).
+    elements: Vec<Element>,
+    /// Every entity an element is on, with the physical tags the elements give it (MSH
+    /// 2.2; none in 4.1, where `$Entities` holds them).
+    element_entities: BTreeMap<(u8, i32), BTreeSet<i32>>,
+    /// The last key added to `element_entities` (elements come in runs on one entity).
+    last_entity: Option<(u8, i32, i32)>,
+    /// Partitioned files (4.1): the parent (dimension, tag) of each partition entity.
+    parents: HashMap<(u8, i32), (u8, i32)>,
+}
+
+impl ModelParts {
+    /// Notes an element of dimension `dim` on entity `tag` in physical group `physical`
+    /// (0: none).
+    #[inline]
+    fn on_entity(&mut self, dim: u8, tag: i32, physical: i32) {
+        if self.last_entity == Some((dim, tag, physical)) {
+            return;
+        }
+        self.last_entity = Some((dim, tag, physical));
+        let set = self.element_entities.entry((dim, tag)).or_default();
+        if physical != 0 {
+            set.insert(physical);
+        }
+    }
+
+    /// The model: partition entities replaced by their parents (elements and node
+    /// classifications on partition interfaces dropped, the parametric coordinates of a
+    /// node moved to a parent of another dimension dropped), nodes the file does not
+    /// classify put on the entity of the lowest-dimension element that holds them (as Gmsh
+    /// reads MSH 2.2), and entities that `$Entities` lacks derived from the elements.
+    fn finish(mut self, data: &MeshData) -> Model {
+        if !self.parents.is_empty() {
+            let parents = &self.parents;
+            for (on, param) in self.node_entity.iter_mut().zip(&mut self.node_param) {
+                if let Some((dim, tag)) = *on {
+                    if let Some(&(pd, pt)) = parents.get(&(dim, tag)) {
+                        *on = Some((pd, pt));
+                        if pd != dim {
+                            *param = None;
+                        }
+                    }
+                }
+            }
+            self.elements
+                .retain_mut(|e| match parents.get(&(e.dim, e.entity)) {
+                    Some(&(pd, pt)) if pd == e.dim => {
+                        e.entity = pt;
+                        true
+                    }
+                    Some(_) => false,
+                    None => true,
+                });
+            let mut entities = BTreeMap::new();
+            for (&(dim, tag), physicals) in &self.element_entities {
+                let key = match parents.get(&(dim, tag)) {
+                    Some(&(pd, pt)) if pd == dim => (dim, pt),
+                    Some(_) => continue,
+                    None => (dim, tag),
+                };
+                entities
+                    .entry(key)
+                    .or_insert_with(BTreeSet::new)
+                    .extend(physicals);
+            }
+            self.element_entities = entities;
+        }
+        let nv = data.vertices.len();
+        self.node_entity.resize(nv, None);
+        self.node_param.resize(nv, None);
+        if self.node_entity.iter().any(Option::is_none) {
+            let on = &mut self.node_entity;
+            let mut classify = |nodes: &[u32], dim: u8, tag: i32| {
+                for &v in nodes {
+                    if let Some(slot @ None) = on.get_mut(v as usize) {
+                        *slot = Some((dim, tag));
+                    }
+                }
+            };
+            for dim in [0, 1] {
+                for e in self.elements.iter().filter(|e| e.dim == dim) {
+                    classify(&e.nodes, dim, e.entity);
+                }
+            }
+            for (t, &s) in data.triangles.iter().zip(&data.triangle_surface) {
+                classify(t, 2, s);
+            }
+            for (q, &s) in data.quads.iter().zip(&data.quad_surface) {
+                classify(q, 2, s);
+            }
+        }
+        let mut entities = self.entities.unwrap_or_default();
+        let known: HashSet<(u8, i32)> = entities.iter().map(|e| (e.dim, e.tag)).collect();
+        for ((dim, tag), physicals) in self.element_entities {
+            if !known.contains(&(dim, tag)) {
+                entities.push(Entity {
+                    dim,
+                    tag,
+                    bbox: None,
+                    physicals: physicals.into_iter().collect(),
+                    bounding: Vec::new(),
+                });
+            }
+        }
+        Model {
+            physical_names: self.physical_names,
+            entities,
+            node_entity: self.node_entity,
+            node_param: self.node_param,
+            elements: self.elements,
+        }
+    }
 }
 
 impl Content {
@@ -704,6 +831,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
         skipped: BTreeMap::new(),
         parents: HashMap::new(),
         interfaces: HashSet::new(),
+        model: ModelParts::default(),
     };
     while let Some((start, name)) = p.token() {
         match name {
@@ -752,6 +880,18 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
                 p.end("$Elements", &|| format!("{n} elements"))?;
                 c.map = Some(map);
             }
+            b"$PhysicalNames" => {
+                if !c.model.physical_names.is_empty() {
+                    return Err(p.err(start, "a second $PhysicalNames section"));
+                }
+                physical_names(&mut p, &mut c)?;
+            }
+            b"$Entities" if version == MshVersion::V41 => {
+                if c.model.entities.is_some() {
+                    return Err(p.err(start, "a second $Entities section"));
+                }
+                entities41(&mut p, &mut c)?;
+            }
             b"$PartitionedEntities" if version == MshVersion::V41 => {
                 partitioned41(&mut p, &mut c)?;
                 p.skip_section(start, name)?;
@@ -781,6 +921,8 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
             }
         }
     }
+    let model = c.model.finish(&c.data);
+    c.data.model = Some(Box::new(model));
     Ok(MshFile {
         data: c.data,
         version,
@@ -865,6 +1007,13 @@ fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
                     p.int_field(s, &what)?;
                 }
             }
+            if let (Ok(t), Ok(pd @ 0..=3), Ok(pt)) = (
+                i32::try_from(tag),
+                u8::try_from(parent_dim),
+                i32::try_from(parent),
+            ) {
+                c.model.parents.insert((dim as u8, t), (pd, pt));
+            }
             if dim == 2 {
                 match parent_dim {
                     2 => {
@@ -879,6 +1028,114 @@ fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
             }
         }
     }
+    Ok(())
+}
+
+/// The `$PhysicalNames` section (ASCII in binary files too): per group, its dimension,
+/// tag and name in double quotes, on a line of its own.
+fn physical_names(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
+    let s = "$PhysicalNames";
+    let n = p.uint(s, &|| "the number of physical names".into())?;
+    for i in 0..n {
+        let what = || format!("physical name {} of {n}", i + 1);
+        let dp = p.pos;
+        let dim = p.int(s, &what)?;
+        p.in_line = true;
+        let tp = p.pos;
+        let tag = p.int(s, &what)?;
+        let Some(dim) = u8::try_from(dim).ok().filter(|&d| d <= 3) else {
+            return Err(p.err(
+                dp,
+                format!("physical group {tag} has dimension {dim} (expected 0 to 3)"),
+            ));
+        };
+        let tag = to_i32(p, tp, tag, "physical tag")?;
+        p.skip_ws();
+        let b = p.b;
+        let open = p.pos;
+        let close = (b.get(open) == Some(&b'"'))
+            .then(|| {
+                b[open + 1..]
+                    .iter()
+                    .position(|&ch| ch == b'"' || ch == b'\n')
+            })
+            .flatten()
+            .map(|k| open + 1 + k)
+            .filter(|&k| b[k] == b'"');
+        let Some(close) = close else {
+            return Err(p.err(
+                open,
+                format!(
+                    "the name of physical group {tag} (dimension {dim}) is not in double quotes on its line"
+                ),
+            ));
+        };
+        let name = String::from_utf8_lossy(&b[open + 1..close]).into_owned();
+        p.pos = close + 1;
+        p.entry_end(&|| format!("the name of physical group {tag}"))?;
+        p.in_line = false;
+        c.model.physical_names.push(PhysicalName { dim, tag, name });
+    }
+    p.end(s, &|| format!("{n} physical names"))
+}
+
+/// The `$Entities` section of MSH 4.1, in either encoding: points (tag, coordinates,
+/// physical tags), then curves, surfaces and volumes (tag, bounding box, physical tags,
+/// signed tags of the bounding entities).
+fn entities41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
+    let s = "$Entities";
+    p.binary_data_start();
+    let counts: Vec<u64> = ["points", "curves", "surfaces", "volumes"]
+        .iter()
+        .map(|what| p.size_t(s, &|| format!("the number of {what}")))
+        .collect::<Res<_>>()?;
+    let mut entities = Vec::new();
+    for (dim, &count) in counts.iter().enumerate() {
+        for i in 0..count {
+            let what = || format!("entity {} of dimension {dim} in $Entities", i + 1);
+            let tp = p.pos;
+            let tag = p.int_field(s, &what)?;
+            let tag = to_i32(p, tp, tag, "entity tag")?;
+            let cp = p.pos;
+            let mut bbox = [0.0; 6];
+            let coordinates = if dim == 0 { 3 } else { 6 };
+            for x in bbox.iter_mut().take(coordinates) {
+                *x = p.double_field(s, &what)?;
+            }
+            if dim == 0 {
+                bbox.copy_within(0..3, 3);
+            }
+            if !bbox.iter().all(|x| x.is_finite()) {
+                let msg = format!("entity {tag} of dimension {dim} has a non-finite coordinate");
+                return Err(p.err(cp, msg));
+            }
+            let tags = |p: &mut Parser<'_>, kind: &str| -> Res<Vec<i32>> {
+                let n = p.size_t(s, &what)?;
+                let mut v = Vec::new();
+                for _ in 0..n {
+                    let at = p.pos;
+                    let t = p.int_field(s, &what)?;
+                    v.push(to_i32(p, at, t, kind)?);
+                }
+                Ok(v)
+            };
+            let physicals = tags(p, "physical tag")?;
+            let bounding = if dim > 0 {
+                tags(p, "bounding entity tag")?
+            } else {
+                Vec::new()
+            };
+            entities.push(Entity {
+                dim: dim as u8,
+                tag,
+                bbox: Some(bbox),
+                physicals,
+                bounding,
+            });
+        }
+    }
+    p.end(s, &|| format!("{} entities", entities.len()))?;
+    c.model.entities = Some(entities);
     Ok(())
 }
 
@@ -908,9 +1165,11 @@ fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     c.data.vertices.reserve(cap(total, min_bytes, left));
     for blk in 0..blocks {
         let what_blk = || format!("the header of node block {} of {blocks}", blk + 1);
+        let dp = p.pos;
         let dim = p.int_field(s, &what_blk)?;
         p.entry_start();
-        p.int_field(s, &what_blk)?;
+        let ep = p.pos;
+        let entity = p.int_field(s, &what_blk)?;
         let parametric = p.int_field(s, &what_blk)?;
         let bp = p.pos;
         let n = p.size_t(s, &what_blk)?;
@@ -925,9 +1184,19 @@ fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
                 ),
             ));
         }
-        let extra = match (parametric, dim) {
-            (0, _) => 0,
-            (1, d @ 0..=3) => d as usize,
+        let Some(dim) = u8::try_from(dim).ok().filter(|&d| d <= 3) else {
+            return Err(p.err(
+                dp,
+                format!(
+                    "node block {} is on an entity of dimension {dim} (expected 0 to 3)",
+                    blk + 1
+                ),
+            ));
+        };
+        let entity = (dim, to_i32(p, ep, entity, "entity tag")?);
+        let extra = match parametric {
+            0 => 0,
+            1 => dim as usize,
             _ => {
                 return Err(p.err(
                     bp,
@@ -935,10 +1204,16 @@ fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
                 ));
             }
         };
+        let block = NodeBlock41 {
+            index: blk,
+            len: n,
+            entity,
+            extra,
+        };
         if p.binary {
-            node_block41_binary(p, c, blk, n, extra)?;
+            node_block41_binary(p, c, &block)?;
         } else {
-            node_block41_ascii(p, c, blk, n, extra)?;
+            node_block41_ascii(p, c, &block)?;
         }
     }
     if c.node_tags.len() as u64 != total {
@@ -953,16 +1228,34 @@ fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     Ok(())
 }
 
-/// The `n` tags, then coordinates (with `extra` parametric ones each), of ASCII node
-/// block `blk`.
-fn node_block41_ascii(
-    p: &mut Parser<'_>,
-    c: &mut Content,
-    blk: u64,
-    n: u64,
+/// An MSH 4.1 node block's header.
+struct NodeBlock41 {
+    /// 0-based position among the section's blocks.
+    index: u64,
+    /// Number of nodes.
+    len: u64,
+    /// The entity (dimension, tag) the nodes are on.
+    entity: (u8, i32),
+    /// Parametric coordinates per node (0 when the block has none).
     extra: usize,
-) -> Res<()> {
+}
+
+/// Records the entity and parametric coordinates (`extra` of `params`) of a node.
+fn classify_node(c: &mut Content, b: &NodeBlock41, params: [f64; 3]) {
+    c.model.node_entity.push(Some(b.entity));
+    c.model.node_param.push(parametric(b.extra, params));
+}
+
+/// The first `n` of `u` as a node's parametric coordinates: none if `n` is 0 or one is not
+/// finite (then they are not written back).
+fn parametric(n: usize, u: [f64; 3]) -> Option<[f64; 3]> {
+    (n > 0 && u.iter().all(|x| x.is_finite())).then_some(u)
+}
+
+/// The tags, then coordinates (with their parametric ones), of an ASCII node block.
+fn node_block41_ascii(p: &mut Parser<'_>, c: &mut Content, b: &NodeBlock41) -> Res<()> {
     let s = "$Nodes";
+    let (blk, n, extra) = (b.index, b.len, b.extra);
     for i in 0..n {
         let tag = p.uint(s, &|| format!("node tag {} of block {}", i + 1, blk + 1))?;
         p.entry_start();
@@ -978,24 +1271,23 @@ fn node_block41_ascii(
         let (_, y) = p.float(s, &what)?;
         let (_, z) = p.float(s, &what)?;
         check_finite(p, at, tag, [x, y, z])?;
-        for _ in 0..extra {
-            p.float(s, &|| format!("a parametric coordinate of node {tag}"))?;
+        let mut params = [0.0; 3];
+        for u in params.iter_mut().take(extra) {
+            *u = p
+                .float(s, &|| format!("a parametric coordinate of node {tag}"))?
+                .1;
         }
         p.entry_end(&|| format!("the coordinates of node {tag}"))?;
         c.data.vertices.push([x, y, z]);
+        classify_node(c, b, params);
     }
     Ok(())
 }
 
 /// The same for a binary node block.
-fn node_block41_binary(
-    p: &mut Parser<'_>,
-    c: &mut Content,
-    blk: u64,
-    n: u64,
-    extra: usize,
-) -> Res<()> {
+fn node_block41_binary(p: &mut Parser<'_>, c: &mut Content, b: &NodeBlock41) -> Res<()> {
     let s = "$Nodes";
+    let (blk, n, extra) = (b.index, b.len, b.extra);
     let what_tags = || format!("the node tags of block {}", blk + 1);
     let tags = p.take_array(n, 8, s, &what_tags)?;
     c.node_tags
@@ -1009,6 +1301,11 @@ fn node_block41_binary(
         let x = [f64_at(v, 0), f64_at(v, 8), f64_at(v, 16)];
         check_finite(p, cp + i * stride, c.node_tags[first + i], x)?;
         c.data.vertices.push(x);
+        let mut params = [0.0; 3];
+        for (k, u) in params.iter_mut().take(extra).enumerate() {
+            *u = f64_at(v, 24 + 8 * k);
+        }
+        classify_node(c, b, params);
     }
     Ok(())
 }
@@ -1063,7 +1360,8 @@ fn parametric_nodes22(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
         let what = || format!("the entity of node {tag}");
         let dp = p.pos;
         let dim = p.int_field(s, &what)?;
-        p.int_field(s, &what)?;
+        let ep = p.pos;
+        let entity = p.int_field(s, &what)?;
         let params = match dim {
             0 | 3 => 0,
             1 => 1,
@@ -1075,8 +1373,10 @@ fn parametric_nodes22(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
                 ));
             }
         };
-        for _ in 0..params {
-            p.double_field(s, &|| format!("a parametric coordinate of node {tag}"))?;
+        let entity = to_i32(p, ep, entity, "entity tag")?;
+        let mut u = [0.0; 3];
+        for slot in u.iter_mut().take(params) {
+            *slot = p.double_field(s, &|| format!("a parametric coordinate of node {tag}"))?;
         }
         p.entry_end(&|| {
             format!("the coordinates, entity and parametric coordinates of node {tag}")
@@ -1084,6 +1384,8 @@ fn parametric_nodes22(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
         check_finite(p, cp, tag as u64, x)?;
         c.node_tags.push(tag as u64);
         c.data.vertices.push(x);
+        c.model.node_entity.push(Some((dim as u8, entity)));
+        c.model.node_param.push(parametric(params, u));
     }
     Ok(())
 }
@@ -1141,6 +1443,46 @@ fn push_element(
     Ok(())
 }
 
+/// Adds a point or line element (`nodes`: its node tags) of element `tag`, type `etype`
+/// and dimension `dim`, on entity `entity`, to the model.
+#[allow(clippy::too_many_arguments)]
+fn push_lower(
+    p: &Parser<'_>,
+    c: &mut Content,
+    map: &NodeMap,
+    at: usize,
+    tag: u64,
+    (etype, dim): (i64, u8),
+    entity: i32,
+    nodes: &[u64],
+) -> Res<()> {
+    let nodes = nodes
+        .iter()
+        .map(|&n| {
+            map.get(n).ok_or_else(|| {
+                let msg = format!("element {tag} refers to node {n}, which does not exist");
+                p.err(at, msg)
+            })
+        })
+        .collect::<Res<Vec<u32>>>()?;
+    c.model.elements.push(Element {
+        gmsh_type: etype,
+        dim,
+        entity,
+        nodes,
+    });
+    Ok(())
+}
+
+/// Whether elements of a type of dimension `dim` with `nodes` nodes go to the model: points
+/// and lines with a fixed number of nodes.
+fn is_lower(dim: u8, nodes: usize) -> bool {
+    dim <= 1 && nodes > 0
+}
+
+/// Most nodes of a point or line element Gmsh knows (Line 11).
+const MAX_LOWER_NODES: usize = 16;
+
 /// The `$Elements` section of MSH 4.1, in either encoding: the headers read alike, the
 /// blocks' elements per encoding. Returns the number of elements.
 fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
@@ -1168,7 +1510,7 @@ fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
             ));
         }
         let surface = to_i32(p, ep, entity, "entity tag")?;
-        let Some((nodes, _, name)) = element_type(etype) else {
+        let Some((nodes, dim, name)) = element_type(etype) else {
             return Err(p.err(
                 tp,
                 unknown_type(&format!("element block {}", blk + 1), etype),
@@ -1178,10 +1520,14 @@ fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u64> {
             index: blk,
             len: n,
             etype,
+            dim,
             nodes,
             surface,
             on_interface: entity_dim == 2 && c.interfaces.contains(&entity),
         };
+        if block.keep() || block.lower() {
+            c.model.on_entity(dim, surface, 0);
+        }
         if p.binary {
             if nodes == 0 {
                 let what = format!("element block {}", blk + 1);
@@ -1209,8 +1555,11 @@ struct Block41 {
     /// Number of elements.
     len: u64,
     etype: i64,
+    /// Dimension of the type.
+    dim: u8,
     /// Nodes per element (0: no fixed number).
     nodes: usize,
+    /// The entity the elements are on.
     surface: i32,
     /// On a partition interface (skipped whatever its type).
     on_interface: bool,
@@ -1220,6 +1569,11 @@ impl Block41 {
     /// Whether the block's elements are read: triangles and quads not on an interface.
     fn keep(&self) -> bool {
         (self.etype == TRIANGLE || self.etype == QUAD) && !self.on_interface
+    }
+
+    /// Whether the block's elements go to the model: points and lines.
+    fn lower(&self) -> bool {
+        is_lower(self.dim, self.nodes)
     }
 }
 
@@ -1234,13 +1588,15 @@ fn element_block41_ascii(
     let s = "$Elements";
     let blk = b.index;
     let keep = b.keep();
+    let lower = b.lower();
+    let store = keep || lower;
     if keep && b.etype == TRIANGLE {
         let k = cap(b.len, 8, p.b.len() - p.pos);
         c.data.triangles.reserve(k);
         c.data.triangle_ids.reserve(k);
         c.data.triangle_surface.reserve(k);
     }
-    let mut nodes = [0u64; 4];
+    let mut nodes = [0u64; MAX_LOWER_NODES];
     for i in 0..b.len {
         let (at, tt) = p.need(s, &|| format!("element {} of block {}", i + 1, blk + 1))?;
         let tag = parse_u64(tt).ok_or_else(|| {
@@ -1255,13 +1611,16 @@ fn element_block41_ascii(
         }
         for k in 0..b.nodes {
             let v = p.uint(s, &|| format!("node {} of element {tag}", k + 1))?;
-            if let (true, Some(slot)) = (keep, nodes.get_mut(k)) {
+            if let (true, Some(slot)) = (store, nodes.get_mut(k)) {
                 *slot = v;
             }
         }
         p.entry_end(&|| element_nodes(tag, b.etype, b.nodes))?;
         if keep {
             push_element(p, c, map, at, tag, b.surface, &nodes[..b.nodes])?;
+        } else if lower {
+            let t = (b.etype, b.dim);
+            push_lower(p, c, map, at, tag, t, b.surface, &nodes[..b.nodes])?;
         }
     }
     if !keep {
@@ -1307,16 +1666,23 @@ fn element_block41_binary(
     let data = p.take_array(b.len, stride, s, &|| {
         format!("element block {}", b.index + 1)
     })?;
-    if b.keep() {
-        let mut nodes = [0u64; 4];
+    if b.keep() || b.lower() {
+        let mut nodes = [0u64; MAX_LOWER_NODES];
         for (i, e) in data.chunks_exact(stride).enumerate() {
             let tag = u64_at(e, 0);
             for (k, slot) in nodes.iter_mut().take(nn).enumerate() {
                 *slot = u64_at(e, 8 + 8 * k);
             }
-            push_element(p, c, map, at0 + i * stride, tag, b.surface, &nodes[..nn])?;
+            let at = at0 + i * stride;
+            if b.keep() {
+                push_element(p, c, map, at, tag, b.surface, &nodes[..nn])?;
+            } else {
+                let t = (b.etype, b.dim);
+                push_lower(p, c, map, at, tag, t, b.surface, &nodes[..nn])?;
+            }
         }
-    } else {
+    }
+    if !b.keep() {
         c.skip(b.etype, b.len, b.on_interface);
     }
     Ok(())
@@ -1336,8 +1702,7 @@ fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u
     c.data.triangles.reserve(k);
     c.data.triangle_ids.reserve(k);
     c.data.triangle_surface.reserve(k);
-    let mut nodes = [0u64; 4];
-    let mut tags = [0i64; 2];
+    let mut nodes = [0u64; MAX_LOWER_NODES];
     for i in 0..total {
         let (at, tt) = p.need(s, &|| format!("element {} of {total}", i + 1))?;
         let tag = parse_u64(tt).ok_or_else(|| {
@@ -1348,10 +1713,11 @@ fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u
         p.entry_start();
         let tp = p.pos;
         let etype = p.int(s, &|| format!("the type of element {tag}"))?;
-        let Some((nn, _, _)) = element_type(etype) else {
+        let Some((nn, dim, _)) = element_type(etype) else {
             return Err(p.err(tp, unknown_type(&format!("element {tag}"), etype)));
         };
         let ntags = p.uint(s, &|| format!("the number of tags of element {tag}"))?;
+        let mut tags = [0i64; 2];
         for k in 0..ntags {
             let v = p.int(s, &|| format!("a tag of element {tag}"))?;
             if let Some(slot) = tags.get_mut(k as usize) {
@@ -1359,6 +1725,7 @@ fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u
             }
         }
         let keep = etype == TRIANGLE || etype == QUAD;
+        let lower = is_lower(dim, nn);
         if !keep {
             c.skip(etype, 1, false);
         }
@@ -1368,15 +1735,21 @@ fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<u
         }
         for k in 0..nn {
             let v = p.uint(s, &|| format!("node {} of element {tag}", k + 1))?;
-            if let (true, Some(slot)) = (keep, nodes.get_mut(k)) {
+            if let (true, Some(slot)) = (keep || lower, nodes.get_mut(k)) {
                 *slot = v;
             }
         }
         p.entry_end(&|| element_nodes(tag, etype, nn))?;
-        if keep {
+        if keep || lower {
             let used = &tags[..(ntags as usize).min(2)];
-            let surface = to_i32(p, at, surface22(used), "elementary tag")?;
-            push_element(p, c, map, at, tag, surface, &nodes[..nn])?;
+            let entity = to_i32(p, at, surface22(used), "elementary tag")?;
+            let physical = to_i32(p, at, tags[0], "physical tag")?;
+            c.model.on_entity(dim, entity, physical);
+            if keep {
+                push_element(p, c, map, at, tag, entity, &nodes[..nn])?;
+            } else {
+                push_lower(p, c, map, at, tag, (etype, dim), entity, &nodes[..nn])?;
+            }
         }
     }
     Ok(total)
@@ -1387,7 +1760,7 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
     let total = p.uint(s, &|| "the number of elements".into())?;
     p.binary_data_start();
     let mut seen = 0u64;
-    let mut nodes = [0u64; 4];
+    let mut nodes = [0u64; MAX_LOWER_NODES];
     while seen < total {
         let hp = p.pos;
         let what = || format!("the header of an element group ({seen} of {total} elements read)");
@@ -1403,7 +1776,7 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
                 ),
             ));
         }
-        let Some((nn, _, name)) = element_type(etype) else {
+        let Some((nn, dim, name)) = element_type(etype) else {
             return Err(p.err(hp, unknown_type("an element group", etype)));
         };
         if nn == 0 {
@@ -1416,21 +1789,30 @@ fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> Res<
             let plural = if n == 1 { "" } else { "s" };
             format!("a group of {n} element{plural} of type {etype}")
         })?;
-        if etype == TRIANGLE || etype == QUAD {
+        let keep = etype == TRIANGLE || etype == QUAD;
+        if keep || is_lower(dim, nn) {
             for (i, e) in data.chunks_exact(stride).enumerate() {
                 let at = at0 + i * stride;
                 let tag = i32_at(e, 0);
                 if tag <= 0 {
                     return Err(p.err_bin(at, format!("bad element tag {tag} (tags are positive)")));
                 }
+                let physical = if ntags >= 1 { i32_at(e, 4) } else { 0 };
                 let surface = if ntags >= 2 { i32_at(e, 8) } else { 0 };
                 for (k, slot) in nodes.iter_mut().take(nn).enumerate() {
                     let v = i32_at(e, 4 * (1 + ntags + k));
                     *slot = u64::try_from(v).unwrap_or(0);
                 }
-                push_element(p, c, map, at, tag as u64, surface, &nodes[..nn])?;
+                c.model.on_entity(dim, surface, physical);
+                if keep {
+                    push_element(p, c, map, at, tag as u64, surface, &nodes[..nn])?;
+                } else {
+                    let t = (etype, dim);
+                    push_lower(p, c, map, at, tag as u64, t, surface, &nodes[..nn])?;
+                }
             }
-        } else {
+        }
+        if !keep {
             c.skip(etype, n as u64, false);
         }
         seen += n as u64;

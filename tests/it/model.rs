@@ -1,0 +1,471 @@
+//! The Gmsh model written back (issue 21, point 4): a `.msh` read from a Gmsh file is
+//! written with its physical groups, entities, node classification, parametric coordinates
+//! and point and line elements, so that Gmsh can go on from it. Checked through Gmsh's own
+//! Python API (and meshio), not our reader.
+
+use crate::util::{gmsh_available, python, repo_path};
+use quadrecomb::mesh::{self, Mesh, Recombined, msh};
+use quadrecomb::quality::{self, CandidateTable};
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Python: what Gmsh reads from `argv[1]`, as one JSON object: physical groups with their
+/// names and entities, element counts by type, the node tags classified on each entity
+/// (boundary excluded) and their parametric coordinates. With `argv[2]` = `smooth`, also
+/// the area before and after `optimize("Laplace2D")` and how many of the nodes that Gmsh
+/// reads on points and curves from `argv[3]` (the input mesh) it moved; with `recombine`,
+/// the area before and after `recombine()`. Areas are
+/// the sum of the elements' absolute areas (a folded mesh grows) and of their signed
+/// areas (which only moving boundary nodes changes), in the xy plane.
+const DESCRIBE: &str = r#"
+import sys, json, gmsh
+import numpy as np
+gmsh.initialize(["-noenv"])
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.open(sys.argv[1])
+mode = sys.argv[2] if len(sys.argv) > 2 else ""
+
+def areas():
+    tags, xyz, _ = gmsh.model.mesh.getNodes()
+    order = np.argsort(tags)
+    tags, xyz = tags[order], xyz.reshape(-1, 3)[order]
+    total_abs, total_signed = 0.0, 0.0
+    for etype, k in ((2, 3), (3, 4)):
+        _, nodes = gmsh.model.mesh.getElementsByType(etype)
+        if len(nodes) == 0:
+            continue
+        p = xyz[np.searchsorted(tags, nodes)].reshape(-1, k, 3)
+        q = np.roll(p, -1, axis=1)
+        a = 0.5 * (p[:, :, 0] * q[:, :, 1] - q[:, :, 0] * p[:, :, 1]).sum(axis=1)
+        total_abs += float(np.abs(a).sum())
+        total_signed += float(a.sum())
+    return [total_abs, total_signed]
+
+def boundary_nodes():
+    tags, xyz, _ = gmsh.model.mesh.getNodes()
+    return dict(zip(tags.tolist(), xyz.reshape(-1, 3).tolist()))
+
+out = {}
+out["groups"] = sorted(
+    [d, t, gmsh.model.getPhysicalName(d, t),
+     sorted(int(e) for e in gmsh.model.getEntitiesForPhysicalGroup(d, t))]
+    for d, t in gmsh.model.getPhysicalGroups())
+out["entities"] = sorted([d, t] for d, t in gmsh.model.getEntities())
+out["elements"] = {str(t): len(gmsh.model.mesh.getElementsByType(t)[0])
+                   for t in (15, 1, 2, 3)}
+nodes, params = {}, {}
+for d, t in gmsh.model.getEntities():
+    tags, _, u = gmsh.model.mesh.getNodes(d, t, includeBoundary=False,
+                                          returnParametricCoord=True)
+    if len(tags):
+        key = f"{d} {t}"
+        nodes[key] = sorted(int(x) for x in tags)
+        if len(u):
+            u = u.reshape(len(tags), -1).tolist()
+            params[key] = sorted([int(x)] + c for x, c in zip(tags, u))
+out["nodes"] = nodes
+out["params"] = params
+if mode == "smooth":
+    before, fixed = areas(), boundary_nodes()
+    gmsh.model.mesh.optimize("Laplace2D")
+    after, moved = areas(), boundary_nodes()
+    gmsh.model.add("input")
+    gmsh.merge(sys.argv[3])
+    boundary = set()
+    for d in (0, 1):
+        boundary.update(gmsh.model.mesh.getNodes(d, -1)[0].tolist())
+    out["area"] = [before, after]
+    out["boundary"] = len(boundary)
+    out["boundary_moved"] = sum(1 for t in boundary if moved[t] != fixed[t])
+elif mode == "recombine":
+    before = areas()
+    gmsh.model.mesh.recombine()
+    out["area"] = [before, areas()]
+gmsh.finalize()
+print(json.dumps(out))
+"#;
+
+/// What Gmsh reads from `path` (see [`DESCRIBE`]), `mode` "", "smooth" (then `input` is
+/// the mesh it was made from) or "recombine".
+fn gmsh_reads(path: &Path, mode: &str) -> Value {
+    gmsh_compares(path, mode, path)
+}
+
+fn gmsh_compares(path: &Path, mode: &str, input: &Path) -> Value {
+    let out = python(DESCRIBE, &[path, Path::new(mode), input]);
+    serde_json::from_str(&out).expect("JSON from the Gmsh script")
+}
+
+fn data(name: &str) -> PathBuf {
+    repo_path("tests/data").join(name)
+}
+
+/// `name` (a file of tests/data, or a built-in mesh) loaded as every command loads it
+/// (spatial order), and its path for Gmsh.
+fn load(name: &str) -> (Mesh, PathBuf) {
+    let path = if mesh::builtin::NAMES.contains(&name) {
+        repo_path("meshes").join(format!("{name}.msh"))
+    } else {
+        data(name)
+    };
+    let m = mesh::load(path.to_str().unwrap()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    (m, path)
+}
+
+/// A matching of candidates in decreasing eta among those with eta > `min_eta`: each
+/// candidate whose triangles are both still free.
+fn greedy(mesh: &Mesh, table: &CandidateTable, min_eta: f64) -> Recombined {
+    let mut order: Vec<usize> = (0..table.pairs.len()).collect();
+    order.sort_by(|&a, &b| table.eta[b].total_cmp(&table.eta[a]));
+    let mut used = vec![false; mesh.num_triangles()];
+    let mut chosen = Vec::new();
+    for c in order {
+        let [a, b] = table.pairs[c];
+        if table.eta[c] > min_eta && !used[a as usize] && !used[b as usize] {
+            used[a as usize] = true;
+            used[b as usize] = true;
+            chosen.push(c as u32);
+        }
+    }
+    quality::recombined(mesh, table, &chosen)
+}
+
+/// Writes `mesh` recombined greedily (eta > `min_eta`) to `dir`/`name` and returns the path
+/// and the recombination.
+fn write_recombined(dir: &Path, name: &str, mesh: &Mesh, min_eta: f64) -> (PathBuf, Recombined) {
+    let table = CandidateTable::build(mesh);
+    let rec = greedy(mesh, &table, min_eta);
+    assert!(!rec.quads.is_empty(), "{name}: nothing recombined");
+    let out = dir.join(name);
+    msh::write(&out, mesh, &rec).unwrap();
+    (out, rec)
+}
+
+fn relative(a: f64, b: f64) -> f64 {
+    (a - b).abs() / a.abs().max(b.abs())
+}
+
+/// Physical groups (dimension, tag, name, entities), entities, point and line elements,
+/// and the nodes on every entity are those Gmsh reads from the input, for MSH 4.1 and 2.2
+/// inputs with named groups and boundary lines (the channel: groups for both surfaces and
+/// for the inlet, outlet and walls) and for the built-in meshes (physical surfaces only,
+/// nodes on their curves and points without line elements).
+#[test]
+fn written_msh_keeps_the_gmsh_model() {
+    if !gmsh_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for name in [
+        "channel_41_ascii.msh",
+        "channel_22_ascii.msh",
+        "sphere",
+        "two_squares_41_bin.msh",
+    ] {
+        let (m, path) = load(name);
+        let (out, rec) = write_recombined(dir.path(), "out.msh", &m, 0.0);
+        let input = gmsh_reads(&path, "");
+        let ours = gmsh_reads(&out, "");
+        for key in ["groups", "entities", "nodes"] {
+            assert_eq!(ours[key], input[key], "{name}: {key}");
+        }
+        for t in ["15", "1"] {
+            assert_eq!(
+                ours["elements"][t], input["elements"][t],
+                "{name}: type {t}"
+            );
+        }
+        assert_eq!(ours["elements"]["2"], rec.leftover.len(), "{name}");
+        assert_eq!(
+            ours["elements"]["3"],
+            rec.quads.len() + m.quads.len(),
+            "{name}"
+        );
+        // Nodes on curves, not all on the surfaces.
+        let on_curves = |v: &Value| -> usize {
+            let nodes = v["nodes"].as_object().unwrap();
+            let curves = nodes.iter().filter(|(k, _)| k.starts_with("1 "));
+            curves.map(|(_, n)| n.as_array().unwrap().len()).sum()
+        };
+        assert!(on_curves(&ours) > 0, "{name}: no node on a curve");
+        assert_eq!(on_curves(&ours), on_curves(&input), "{name}");
+    }
+    // The channel's groups as the script made them.
+    let (m, _) = load("channel_41_ascii.msh");
+    let (out, _) = write_recombined(dir.path(), "channel.msh", &m, 0.0);
+    let ours = gmsh_reads(&out, "");
+    let names: Vec<(u64, &str)> = ours["groups"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| (g[0].as_u64().unwrap(), g[2].as_str().unwrap()))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            (1, "inlet"),
+            (1, "outlet"),
+            (1, "walls"),
+            (2, "left"),
+            (2, "right")
+        ]
+    );
+    assert!(ours["elements"]["1"].as_u64().unwrap() > 20);
+}
+
+/// Parametric coordinates of the input's nodes on curves and surfaces come back, from
+/// MSH 4.1 `$Nodes` and from MSH 2.2 `$ParametricNodes`.
+#[test]
+fn parametric_coordinates_are_written_back() {
+    if !gmsh_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for name in [
+        "param_41_ascii.msh",
+        "param_41_bin.msh",
+        "param_22_ascii.msh",
+    ] {
+        let (m, path) = load(name);
+        let out = dir.path().join("out.msh");
+        msh::write(&out, &m, &Recombined::unrecombined(&m)).unwrap();
+        let input = gmsh_reads(&path, "");
+        let ours = gmsh_reads(&out, "");
+        assert!(
+            input["params"].as_object().unwrap().len() >= 2,
+            "{name}: {}",
+            input["params"]
+        );
+        assert_eq!(ours["params"], input["params"], "{name}");
+        assert_eq!(ours["nodes"], input["nodes"], "{name}");
+    }
+}
+
+/// `optimize("Laplace2D")` leaves the boundary where it is: nodes on points and curves do
+/// not move and the domain's area stays within 1e-6 (relative), on our recombined channel
+/// as on Gmsh's own recombination of it; on borouchaki the signed area too (its absolute
+/// area also needs quads that are valid, which eta > 0.3 gives here). And `recombine()`
+/// keeps the area: before the model was written, Gmsh's recombination of our borouchaki
+/// dropped elements (6 % of the area) and smoothing moved its boundary.
+#[test]
+fn gmsh_smooths_and_recombines_our_output() {
+    if !gmsh_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // Gmsh's own recombination of the channel, for comparison.
+    let gmsh_own = dir.path().join("gmsh_own.msh");
+    let script = r#"
+import sys, gmsh
+gmsh.initialize(["-noenv"])
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.open(sys.argv[1])
+gmsh.model.mesh.recombine()
+gmsh.write(sys.argv[2])
+gmsh.finalize()
+"#;
+    python(script, &[&data("channel_41_ascii.msh"), &gmsh_own]);
+    let (channel, _) = load("channel_41_ascii.msh");
+    let (ours, _) = write_recombined(dir.path(), "channel.msh", &channel, 0.0);
+    let (borouchaki, b_input) = load("borouchaki");
+    let c_input = data("channel_41_ascii.msh");
+    let (b_all, _) = write_recombined(dir.path(), "b_all.msh", &borouchaki, 0.0);
+    let (b_valid, _) = write_recombined(dir.path(), "b_valid.msh", &borouchaki, 0.3);
+    for (what, path, input, absolute) in [
+        ("Gmsh's channel", &gmsh_own, &c_input, true),
+        ("our channel", &ours, &c_input, true),
+        ("our borouchaki", &b_all, &b_input, false),
+        ("our borouchaki, eta > 0.3", &b_valid, &b_input, true),
+    ] {
+        let r = gmsh_compares(path, "smooth", input);
+        assert!(
+            r["boundary"].as_u64().unwrap() > 60,
+            "{what}: {}",
+            r["boundary"]
+        );
+        assert_eq!(r["boundary_moved"], 0, "{what}: boundary nodes moved");
+        let area = |i: usize, k: usize| r["area"][i][k].as_f64().unwrap();
+        assert!(area(0, 0) > 0.5, "{what}: {}", r["area"]);
+        let signed = relative(area(0, 1), area(1, 1));
+        assert!(signed < 1e-6, "{what}: signed area {}", r["area"]);
+        if absolute {
+            let abs = relative(area(0, 0), area(1, 0));
+            assert!(abs < 1e-6, "{what}: area {}", r["area"]);
+        }
+    }
+    for (what, path) in [("our channel", &ours), ("our borouchaki", &b_all)] {
+        let r = gmsh_reads(path, "recombine");
+        let area = |i: usize| r["area"][i][0].as_f64().unwrap();
+        assert!(relative(area(0), area(1)) < 1e-6, "{what}: {}", r["area"]);
+    }
+}
+
+/// A partitioned mesh is written on its unpartitioned model: Gmsh reads the same
+/// entities, groups, points, lines and node classification (the number of nodes on each
+/// entity: Gmsh numbers the nodes of a partitioned mesh differently in 2.2 and 4.1) from
+/// our output of the partitioned box (4.1 ASCII and binary) as from our output of the
+/// unpartitioned one, and the same from our outputs of the partitioned square in 4.1 and
+/// 2.2.
+#[test]
+fn partitioned_input_writes_the_unpartitioned_model() {
+    if !gmsh_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // Files that must give the same model, and its number of entities per dimension.
+    let cases: [(&[&str], [usize; 4]); 2] = [
+        (
+            &[
+                "box_41_ascii.msh",
+                "box_parts_41_ascii.msh",
+                "box_parts_41_bin.msh",
+            ],
+            [8, 12, 6, 1],
+        ),
+        (
+            &[
+                "parts_41_ascii.msh",
+                "parts_41_bin.msh",
+                "parts_22_ascii.msh",
+            ],
+            [4, 4, 1, 0],
+        ),
+    ];
+    for (names, want) in cases {
+        let mut seen = Vec::new();
+        for &name in names {
+            let (m, _) = load(name);
+            let out = dir.path().join(format!("{name}.out.msh"));
+            msh::write(&out, &m, &Recombined::unrecombined(&m)).unwrap();
+            seen.push((name, gmsh_reads(&out, "")));
+        }
+        let (first, reference) = &seen[0];
+        let dims: Vec<u64> = reference["entities"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e[0].as_u64().unwrap())
+            .collect();
+        let count = |d: u64| dims.iter().filter(|&&x| x == d).count();
+        assert_eq!([0, 1, 2, 3].map(count), want, "{first}");
+        assert!(reference["elements"]["1"].as_u64().unwrap() > 0, "{first}");
+        let per_entity = |r: &Value| -> BTreeMap<String, usize> {
+            let nodes = r["nodes"].as_object().unwrap();
+            let count = |n: &Value| n.as_array().unwrap().len();
+            nodes.iter().map(|(k, n)| (k.clone(), count(n))).collect()
+        };
+        for (name, r) in &seen[1..] {
+            for key in ["groups", "entities", "elements"] {
+                assert_eq!(r[key], reference[key], "{name} vs {first}: {key}");
+            }
+            assert_eq!(per_entity(r), per_entity(reference), "{name} vs {first}");
+        }
+    }
+}
+
+/// meshio reads our file with its physical groups: cells by type and the group names.
+#[test]
+fn meshio_reads_the_model() {
+    if !gmsh_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (m, _) = load("channel_41_ascii.msh");
+    let (out, rec) = write_recombined(dir.path(), "channel.msh", &m, 0.0);
+    let script = r#"
+import sys, json, meshio
+m = meshio.read(sys.argv[1])
+cells = {}
+for c in m.cells:
+    cells[c.type] = cells.get(c.type, 0) + len(c.data)
+print(json.dumps({"cells": cells, "names": sorted(m.field_data)}))
+"#;
+    let r: Value = serde_json::from_str(&python(script, &[&out])).unwrap();
+    assert_eq!(r["cells"]["quad"], rec.quads.len());
+    assert_eq!(r["cells"]["triangle"], rec.leftover.len());
+    let input = gmsh_reads(&data("channel_41_ascii.msh"), "");
+    assert_eq!(r["cells"]["line"], input["elements"]["1"]);
+    assert_eq!(
+        r["names"],
+        serde_json::json!(["inlet", "left", "outlet", "right", "walls"])
+    );
+}
+
+/// The model follows the spatial order: every node keeps its entity and parametric
+/// coordinates, every line its nodes (by tag), whether the mesh is read in file order or
+/// loaded in spatial order.
+#[test]
+fn model_follows_the_spatial_order() {
+    for name in [
+        "param_41_ascii.msh",
+        "channel_22_ascii.msh",
+        "box_parts_41_bin.msh",
+    ] {
+        let path = data(name);
+        let read = msh::read(&path).unwrap();
+        let loaded = mesh::load(path.to_str().unwrap()).unwrap();
+        assert_ne!(read.vertex_ids, loaded.vertex_ids, "{name}: nothing moved");
+        type Classification = BTreeMap<u64, (Option<(u8, i32)>, Option<[u64; 3]>)>;
+        let by_tag = |m: &Mesh| -> (Classification, Vec<(i64, i32, Vec<u64>)>) {
+            let model = m.model.as_ref().expect("a model");
+            let nodes = m
+                .vertex_ids
+                .iter()
+                .enumerate()
+                .map(|(v, &t)| {
+                    let u = model.node_param[v].map(|u| u.map(f64::to_bits));
+                    (t, (model.node_entity[v], u))
+                })
+                .collect();
+            let mut lines: Vec<_> = model
+                .elements
+                .iter()
+                .map(|e| {
+                    let tags = e.nodes.iter().map(|&v| m.vertex_ids[v as usize]).collect();
+                    (e.gmsh_type, e.entity, tags)
+                })
+                .collect();
+            lines.sort();
+            (nodes, lines)
+        };
+        let (a, b) = (by_tag(&read), by_tag(&loaded));
+        assert_eq!(a, b, "{name}");
+        assert!(a.0.values().all(|(on, _)| on.is_some()), "{name}");
+        assert!(!a.1.is_empty(), "{name}");
+    }
+}
+
+/// Generated meshes have no model and are written as before: one surface entity, nodes on
+/// it, no physical names, points or lines.
+#[test]
+fn generated_meshes_are_written_without_a_model() {
+    let m = mesh::generate::grid(mesh::generate::GridSpec {
+        triangles: 50,
+        seed: 3,
+        ..Default::default()
+    });
+    assert!(m.model.is_none());
+    let mut out = Vec::new();
+    msh::write_to(&mut out, &m, &Recombined::unrecombined(&m)).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    assert!(
+        text.starts_with("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 1 0\n"),
+        "{}",
+        &text[..200]
+    );
+    assert!(!text.contains("$PhysicalNames"));
+}
+
+/// A point or line element on a node that does not exist is refused like a triangle
+/// (it is written back, so it must be read).
+#[test]
+fn lines_on_missing_nodes_are_refused() {
+    let text = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n$Elements\n2\n1 1 2 1 1 1 9\n2 2 2 1 1 1 2 3\n$EndElements\n";
+    let err = msh::read_bytes("l.msh", text.as_bytes()).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains("l.msh:12") && msg.contains("element 1 refers to node 9"),
+        "{msg}"
+    );
+}
