@@ -137,38 +137,18 @@ pub fn write_mesh_output(
     mesh: &quadrecomb::mesh::Mesh,
     rec: &quadrecomb::mesh::Recombined,
 ) -> Result<(), BadInput> {
-    use std::io::Write;
-    let fail = |e: &dyn std::fmt::Display| {
+    let vtu = output_kind(path) == Some(true);
+    quadrecomb::output::write_atomic(path, |mut w| {
+        if vtu {
+            quadrecomb::mesh::vtu::write_to(&mut w, mesh, rec)
+        } else {
+            quadrecomb::mesh::msh::write_to(&mut w, mesh, rec)
+        }
+    })
+    .map_err(|e| {
         BadInput(format!(
             "cannot write output {} (through a temporary file beside it): {e}",
             path.display()
         ))
-    };
-    // Through a symbolic link: replace the file it points to, not the link.
-    let resolved = std::fs::canonicalize(path).ok();
-    let path = resolved.as_deref().unwrap_or(path);
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(format!(".tmp-{}", std::process::id()));
-    let tmp = std::path::PathBuf::from(tmp);
-    let written = (|| -> std::io::Result<()> {
-        let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-        if output_kind(path) == Some(true) {
-            quadrecomb::mesh::vtu::write_to(&mut w, mesh, rec)?;
-        } else {
-            quadrecomb::mesh::msh::write_to(&mut w, mesh, rec)?;
-        }
-        w.flush()?;
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        // An existing file keeps its permissions; the data reaches the disk before the
-        // rename makes it the file.
-        if let Ok(meta) = std::fs::metadata(path) {
-            file.set_permissions(meta.permissions())?;
-        }
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    written.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        fail(&e)
     })
 }

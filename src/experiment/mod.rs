@@ -128,13 +128,10 @@ impl ExperimentError {
     }
 }
 
-/// Writes a file through a temporary sibling and a rename, so readers never see half of it.
+/// Writes a file through a temporary sibling and a rename ([`crate::output`]), so readers
+/// never see half of it.
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExperimentError> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, bytes).map_err(|e| ExperimentError::io(&tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| ExperimentError::io(path, e))
+    crate::output::write_bytes(path, bytes).map_err(|e| ExperimentError::io(path, e))
 }
 
 /// Version recorded in records and manifests.

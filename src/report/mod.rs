@@ -121,14 +121,14 @@ pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportErro
     let mut figures = Vec::new();
     for (file, svg) in doc.figures() {
         let path = dir.join(file);
-        std::fs::write(&path, svg).map_err(io(&path))?;
+        crate::output::write_bytes(&path, svg.as_bytes()).map_err(io(&path))?;
         figures.push(path);
     }
     let markdown = dir.join("report.md");
-    std::fs::write(&markdown, doc.to_markdown()).map_err(io(&markdown))?;
+    crate::output::write_bytes(&markdown, doc.to_markdown().as_bytes()).map_err(io(&markdown))?;
     let html = dir.join("report.html");
     let title = format!("quadrecomb report: {}", dir.display());
-    std::fs::write(&html, doc.to_html(&title)).map_err(io(&html))?;
+    crate::output::write_bytes(&html, doc.to_html(&title).as_bytes()).map_err(io(&html))?;
     Ok(ReportPaths {
         markdown,
         html,

@@ -1,0 +1,132 @@
+//! Reliability of what the CLI reads and writes (issue 26): outputs written whole or not at
+//! all, never over the input or a special file; one sweep per directory; records checked
+//! before they are believed; bad sizes and inputs refused with a message.
+
+use crate::util::{bin, run_in};
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A small sweep (sphere, selective h = 1, 2 and greedy) into `dir/name`, with its report.
+fn small_sweep(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
+    let mut args = vec![
+        "sweep",
+        "--mesh",
+        "sphere",
+        "--algo",
+        "selective",
+        "greedy",
+        "--horizons",
+        "1,2",
+        "--runs",
+        "3",
+        "--backend",
+        "cpu",
+        "--out",
+        name,
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    let o = run_in(dir, &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    dir.join(name)
+}
+
+/// Every regular file under `dir` (relative path, content), sorted.
+fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().into_owned();
+                out.push((rel, std::fs::read(&p).unwrap_or_default()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn names(snap: &[(String, Vec<u8>)]) -> Vec<&str> {
+    snap.iter().map(|(n, _)| n.as_str()).collect()
+}
+
+#[cfg(unix)]
+fn mkfifo(path: &Path) -> bool {
+    std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// Item 5: a report that runs out of space (here a file size limit: writes beyond 10 KiB
+/// fail with EFBIG, as on a full disk) leaves the earlier report whole and no temporary.
+#[cfg(unix)]
+#[test]
+fn a_report_that_cannot_be_written_leaves_the_earlier_one_whole() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = small_sweep(tmp.path(), "d", &[]);
+    let before = snapshot(&dir);
+    assert!(
+        names(&before).contains(&"report.md"),
+        "{:?}",
+        names(&before)
+    );
+    let o = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "trap '' XFSZ; ulimit -f 10; exec {} report d --no-pictures",
+            bin().display()
+        ))
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    assert!(!o.status.success(), "the write should have failed");
+    assert!(stderr(&o).contains("File too large"), "{}", stderr(&o));
+    let after = snapshot(&dir);
+    assert_eq!(names(&after), names(&before));
+    assert!(after == before, "a file changed after a failed report");
+}
+
+/// Item 4: the output path is a FIFO (or a device): it is refused, not replaced by a
+/// regular file, and no temporary is left.
+#[cfg(unix)]
+#[test]
+fn an_output_that_is_a_fifo_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let fifo = tmp.path().join("out.msh");
+    if !mkfifo(&fifo) {
+        eprintln!("skipping: mkfifo is not available");
+        return;
+    }
+    let o = run_in(
+        tmp.path(),
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "greedy",
+            "--no-optimum",
+            "-o",
+            "out.msh",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("FIFO"), "{}", stderr(&o));
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::symlink_metadata(&fifo)
+            .unwrap()
+            .file_type()
+            .is_fifo()
+    );
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert_eq!(left.len(), 1, "a temporary was left behind");
+}
