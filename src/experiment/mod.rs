@@ -72,13 +72,14 @@ pub enum ExperimentError {
     },
     /// Another live process is writing the results directory.
     #[error(
-        "{dir}: another sweep (process {pid}) is writing there; wait for it, stop it, or choose another --out"
+        "{dir}: another sweep{} is writing there; wait for it, stop it, or choose another --out",
+        pid.map_or(String::new(), |p| format!(" (process {p})"))
     )]
     Busy {
         /// The directory.
         dir: PathBuf,
-        /// The process holding `DIR/.lock`.
-        pid: u32,
+        /// The process holding the lock on `DIR/.lock`, when it could be read.
+        pid: Option<u32>,
     },
     /// Shards cannot be merged: missing, duplicated or foreign runs.
     #[error("merge: {0}")]
