@@ -117,6 +117,33 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), BadInput> {
     }
 }
 
+/// Refuses an output that is the input mesh file itself, however it is spelled (`./in.msh`,
+/// a symbolic or hard link): the same file by device and inode. Writing it would destroy the
+/// input.
+pub fn check_not_input(output: Option<&std::path::Path>, input: &str) -> Result<(), BadInput> {
+    let Some(out) = output else {
+        return Ok(());
+    };
+    let (Ok(a), Ok(b)) = (std::fs::metadata(out), std::fs::metadata(input)) else {
+        return Ok(());
+    };
+    #[cfg(unix)]
+    let same = {
+        use std::os::unix::fs::MetadataExt;
+        a.dev() == b.dev() && a.ino() == b.ino()
+    };
+    #[cfg(not(unix))]
+    let same = std::fs::canonicalize(out).ok() == std::fs::canonicalize(input).ok();
+    if same {
+        return Err(BadInput(format!(
+            "output {} is the input mesh {input}: refusing to overwrite the input; choose \
+             another -o",
+            out.display()
+        )));
+    }
+    Ok(())
+}
+
 /// `Some(true)` for a `.vtu` path, `Some(false)` for `.msh`, `None` otherwise (any case).
 fn output_kind(path: &std::path::Path) -> Option<bool> {
     let ext = path.extension()?;

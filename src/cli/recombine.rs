@@ -90,6 +90,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         eprintln!("note: --horizon is ignored: {name} looks no further than one action");
     }
     super::check_mesh_output(args.output.as_deref())?;
+    super::check_not_input(args.output.as_deref(), &args.mesh)?;
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
     let (table, backend) = eta_table(&mesh, args.backend)?;
     let out = search::run(&mesh, &table, algo, args.seed);

@@ -215,3 +215,46 @@ fn concurrent_sweeps_never_interleave_records() {
         assert!(!tmp.path().join(&out).join(".lock").exists());
     }
 }
+
+/// Item 1: `-o` naming the input, as given, as `./in.msh`, through a symbolic link or a hard
+/// link, is refused (exit 2) and the input is left untouched; another name is fine.
+#[cfg(unix)]
+#[test]
+fn an_output_that_is_the_input_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run_in(
+        tmp.path(),
+        &[
+            "generate",
+            "grid",
+            "--triangles",
+            "50",
+            "--seed",
+            "1",
+            "-o",
+            "in.msh",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::os::unix::fs::symlink("in.msh", tmp.path().join("link.msh")).unwrap();
+    std::fs::hard_link(tmp.path().join("in.msh"), tmp.path().join("hard.msh")).unwrap();
+    let input = std::fs::read(tmp.path().join("in.msh")).unwrap();
+    for cmd in [
+        &["recombine", "in.msh", "--algo", "greedy"][..],
+        &["optimum", "in.msh"],
+    ] {
+        for out in ["in.msh", "./in.msh", "link.msh", "hard.msh"] {
+            let mut args = cmd.to_vec();
+            args.extend(["-o", out]);
+            let o = run_in(tmp.path(), &args);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+            assert!(stderr(&o).contains("is the input mesh"), "{}", stderr(&o));
+            assert_eq!(std::fs::read(tmp.path().join("in.msh")).unwrap(), input);
+        }
+    }
+    let o = run_in(
+        tmp.path(),
+        &["recombine", "in.msh", "--algo", "greedy", "-o", "out.msh"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+}
