@@ -131,29 +131,77 @@ pub(crate) fn check_records(
     Ok(seen)
 }
 
-/// Removes what an earlier sweep wrote into `dir` (runs, manifest, summary, report, figures).
+/// Removes what an earlier sweep wrote into `dir`, and nothing else: only a directory with a
+/// sweep's manifest is touched, and only the files a sweep names (runs, manifest, summary,
+/// report, and the figures its report listed in [`REPORT_FILES`]); `figures/` goes only if
+/// that leaves it empty. A directory without a manifest keeps everything.
 fn clear_results(dir: &Path) -> Result<(), ExperimentError> {
-    for name in [
-        RUNS_FILE,
-        MANIFEST_FILE,
-        "summary.csv",
-        "summary.json",
-        "report.md",
-        "report.html",
-    ] {
-        match std::fs::remove_file(dir.join(name)) {
+    if !dir.join(MANIFEST_FILE).exists() {
+        return Ok(());
+    }
+    // Refuses a manifest that is not a sweep's (before deleting anything).
+    Manifest::read(dir)?;
+    let mut names: Vec<PathBuf> = report_files(dir)?.into_iter().map(PathBuf::from).collect();
+    names.extend(
+        [
+            REPORT_FILES,
+            RUNS_FILE,
+            MANIFEST_FILE,
+            summary::SUMMARY_CSV,
+            summary::SUMMARY_JSON,
+            "report.md",
+            "report.html",
+        ]
+        .map(PathBuf::from),
+    );
+    for name in names {
+        let path = dir.join(name);
+        match std::fs::remove_file(&path) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(ExperimentError::io(&dir.join(name), e));
+                return Err(ExperimentError::io(&path, e));
             }
             _ => {}
         }
     }
-    match std::fs::remove_dir_all(dir.join("figures")) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(ExperimentError::io(&dir.join("figures"), e))
+    // Only when empty: a file the sweep did not write stays, and so does its directory.
+    let _ = std::fs::remove_dir(dir.join(FIGURES_DIR));
+    Ok(())
+}
+
+/// File in a results directory listing the figures its report wrote, one relative path a
+/// line, so that `--overwrite` and the next report remove those and no other file.
+pub const REPORT_FILES: &str = "report-files.txt";
+/// Sub-directory of a report's figures.
+pub const FIGURES_DIR: &str = "figures";
+
+/// The figures `dir`'s last report wrote (from [`REPORT_FILES`]; none if it is missing).
+/// Only plain `figures/NAME.svg` paths are taken: a line naming anything else is an error,
+/// not a file to delete.
+pub fn report_files(dir: &Path) -> Result<Vec<String>, ExperimentError> {
+    let path = dir.join(REPORT_FILES);
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(ExperimentError::io(&path, e)),
+    };
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let ok = line
+            .strip_prefix("figures/")
+            .and_then(|n| n.strip_suffix(".svg"))
+            .is_some_and(|n| !n.is_empty() && !n.contains(['/', '\\']) && !n.starts_with('.'));
+        if !ok {
+            return Err(ExperimentError::Corrupt {
+                path,
+                message: format!(
+                    "line {}: {line:?} is not a figure a report writes (figures/NAME.svg)",
+                    i + 1
+                ),
+            });
         }
-        _ => Ok(()),
+        out.push(line.to_string());
     }
+    Ok(out)
 }
 
 /// Runs the sweep described by `manifest` (its spec and shard) into `opts.dir`.

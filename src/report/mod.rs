@@ -101,8 +101,7 @@ pub struct ReportPaths {
     pub figures: Vec<PathBuf>,
 }
 
-/// Sub-directory of the figures.
-pub const FIGURES_DIR: &str = "figures";
+pub use crate::experiment::engine::FIGURES_DIR;
 
 /// Reads `dir`'s results and writes `dir/report.md`, `dir/report.html` and `dir/figures/*.svg`.
 pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportError> {
@@ -118,11 +117,24 @@ pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportErro
         move |source| ReportError::Io { path, source }
     };
     std::fs::create_dir_all(&fig_dir).map_err(io(&fig_dir))?;
+    let earlier = crate::experiment::engine::report_files(dir)?;
     let mut figures = Vec::new();
+    let mut list = String::new();
     for (file, svg) in doc.figures() {
         let path = dir.join(file);
         crate::output::write_bytes(&path, svg.as_bytes()).map_err(io(&path))?;
         figures.push(path);
+        list.push_str(file);
+        list.push('\n');
+    }
+    // The list of what this report wrote (what `sweep --overwrite` may delete), then the
+    // figures of the earlier report that this one no longer draws.
+    let listed = dir.join(crate::experiment::engine::REPORT_FILES);
+    crate::output::write_bytes(&listed, list.as_bytes()).map_err(io(&listed))?;
+    for old in earlier {
+        if !list.lines().any(|l| l == old) {
+            let _ = std::fs::remove_file(dir.join(old));
+        }
     }
     let markdown = dir.join("report.md");
     crate::output::write_bytes(&markdown, doc.to_markdown().as_bytes()).map_err(io(&markdown))?;

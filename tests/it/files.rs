@@ -258,3 +258,87 @@ fn an_output_that_is_the_input_is_refused() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// Item 2: `sweep --overwrite` into a directory that was never a sweep's deletes nothing of
+/// it; into a sweep's directory it deletes the sweep's files and the figures its report
+/// listed, nothing else (a file of the user's in `figures/` stays).
+#[test]
+fn overwrite_deletes_only_what_a_sweep_wrote() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("p");
+    std::fs::create_dir_all(p.join("figures/sub")).unwrap();
+    std::fs::write(p.join("figures/sub/fig1.pdf"), "x").unwrap();
+    std::fs::write(p.join("report.md"), "n").unwrap();
+    std::fs::write(p.join("summary.csv"), "mine").unwrap();
+    let before = snapshot(&p);
+    let args = [
+        "sweep",
+        "--mesh",
+        "sphere",
+        "--algo",
+        "greedy",
+        "--horizons",
+        "1",
+        "--runs",
+        "1",
+        "--overwrite",
+        "--out",
+        "p",
+        "--no-report",
+        "-q",
+        "--backend",
+        "cpu",
+    ];
+    let o = run_in(tmp.path(), &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let after = snapshot(&p);
+    for (name, bytes) in &before {
+        if name != "summary.csv" {
+            assert!(
+                after.contains(&(name.clone(), bytes.clone())),
+                "{name} was touched"
+            );
+        }
+    }
+
+    // A sweep's directory with a report, and a file of the user's among its figures.
+    let d = small_sweep(tmp.path(), "d", &[]);
+    let figures = names(&snapshot(&d.join("figures")))
+        .iter()
+        .map(|s| s.to_string())
+        .collect::<Vec<_>>();
+    assert!(figures.len() >= 3, "{figures:?}");
+    std::fs::write(d.join("figures/mine.pdf"), "keep").unwrap();
+    std::fs::write(d.join("notes.txt"), "keep").unwrap();
+    let o = run_in(
+        tmp.path(),
+        &[
+            "sweep",
+            "--mesh",
+            "sphere",
+            "--algo",
+            "greedy",
+            "--out",
+            "d",
+            "--overwrite",
+            "--no-report",
+            "-q",
+            "--backend",
+            "cpu",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let left = snapshot(&d);
+    let left = names(&left);
+    assert!(
+        left.contains(&"figures/mine.pdf") && left.contains(&"notes.txt"),
+        "{left:?}"
+    );
+    for f in &figures {
+        assert!(
+            !left.contains(&format!("figures/{f}").as_str()),
+            "{f} left: {left:?}"
+        );
+    }
+    assert!(!left.contains(&"report.md"), "{left:?}");
+}
