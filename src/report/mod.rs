@@ -106,6 +106,8 @@ pub use crate::experiment::engine::FIGURES_DIR;
 /// Reads `dir`'s results and writes `dir/report.md`, `dir/report.html` and `dir/figures/*.svg`.
 pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportError> {
     let results = Results::read(dir)?;
+    // The summary follows the runs it is made of (it was left stale after an edit).
+    crate::experiment::summary::write(dir, &results.runs())?;
     let other = match &opts.compare {
         Some(d) => Some(Results::read(d)?),
         None => None,

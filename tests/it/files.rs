@@ -208,7 +208,10 @@ fn concurrent_sweeps_never_interleave_records() {
                 rec["horizon"].clone(),
                 rec["run"].clone(),
             );
-            assert!(keys.insert(format!("{key:?}")), "round {round}: {line} twice");
+            assert!(
+                keys.insert(format!("{key:?}")),
+                "round {round}: {line} twice"
+            );
         }
         assert!(text.ends_with('\n'));
         assert_eq!(keys.len(), planned, "round {round}");
@@ -341,4 +344,172 @@ fn overwrite_deletes_only_what_a_sweep_wrote() {
         );
     }
     assert!(!left.contains(&"report.md"), "{left:?}");
+}
+
+fn lines_of(path: &Path) -> Vec<String> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect()
+}
+
+fn edit_line(line: &str, f: impl FnOnce(&mut serde_json::Value)) -> String {
+    let mut v: serde_json::Value = serde_json::from_str(line).unwrap();
+    f(&mut v);
+    serde_json::to_string(&v).unwrap()
+}
+
+/// Item 6: `report` and `merge` refuse records no run of the sweep can have, naming the
+/// line: a duplicate (83 runs were shown for 64), a configuration the sweep does not hold
+/// (h = 77), another mesh (zero hash), a quality_pct of 150 or a quality above the optimum
+/// with as many quads. `report` rewrites summary.csv from the runs it reads.
+#[test]
+fn report_and_merge_refuse_records_no_run_can_have() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = small_sweep(tmp.path(), "d", &["--algo", "optimum", "--no-report"]);
+    let runs = d.join("runs.jsonl");
+    let good = lines_of(&runs);
+    let n = good.len();
+    let optimum_line = good.iter().position(|l| l.contains("\"optimum\"")).unwrap();
+    let tampered: Vec<(&str, Vec<String>, String)> = vec![
+        (
+            "recorded twice (first on line 3)",
+            {
+                let mut l = good.clone();
+                l.push(good[2].clone());
+                l
+            },
+            format!("line {}", n + 1),
+        ),
+        (
+            "not part of this sweep",
+            {
+                let mut l = good.clone();
+                l[1] = edit_line(&l[1], |v| v["horizon"] = 77.into());
+                l
+            },
+            "runs.jsonl:2".into(),
+        ),
+        (
+            "mesh hash",
+            {
+                let mut l = good.clone();
+                l[0] = edit_line(&l[0], |v| v["mesh_hash"] = "0".repeat(64).into());
+                l
+            },
+            "runs.jsonl:1".into(),
+        ),
+        (
+            "quality_pct 150",
+            {
+                let mut l = good.clone();
+                l[3] = edit_line(&l[3], |v| v["quality_pct"] = 150.0.into());
+                l
+            },
+            "line 4".into(),
+        ),
+        (
+            "above the exact optimum",
+            {
+                let mut l = good.clone();
+                let i = optimum_line;
+                l[i] = edit_line(&l[i], |v| {
+                    let q = v["quality"].as_f64().unwrap() * 1.5;
+                    v["quality"] = q.into();
+                    v["quality_pct"] = 150.0.into();
+                });
+                l
+            },
+            format!("line {}", optimum_line + 1),
+        ),
+    ];
+    for (why, lines, at) in tampered {
+        std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
+        for cmd in [
+            &["report", "d", "--no-pictures"][..],
+            &["merge", "d", "--out", "m"],
+        ] {
+            let o = run_in(tmp.path(), cmd);
+            let e = stderr(&o);
+            assert_eq!(o.status.code(), Some(2), "{cmd:?} {why}: {e}");
+            assert!(
+                e.contains(why) && e.contains(&at),
+                "{cmd:?} {why} {at}: {e}"
+            );
+            assert!(!tmp.path().join("m/runs.jsonl").exists());
+        }
+    }
+    std::fs::write(&runs, good.join("\n") + "\n").unwrap();
+    let summary = std::fs::read(d.join("summary.csv")).unwrap();
+    std::fs::write(d.join("summary.csv"), "stale\n").unwrap();
+    let o = run_in(tmp.path(), &["report", "d", "--no-pictures"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(d.join("summary.csv")).unwrap(), summary);
+}
+
+/// Item 6: an optimum cache whose quality was edited (bits included) is not believed: the
+/// sweep recomputes it (greedy was recorded at 166 % of a tampered optimum), and
+/// `--overwrite` never reads the cache.
+#[test]
+fn an_edited_optimum_cache_is_recomputed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let args = |out: &str, extra: &'static str| {
+        let mut a = vec![
+            "sweep",
+            "--mesh",
+            "sphere",
+            "--algo",
+            "greedy",
+            "optimum",
+            "--backend",
+            "cpu",
+            "--out",
+            out,
+            "-q",
+            "--no-report",
+        ];
+        if !extra.is_empty() {
+            a.push(extra);
+        }
+        a.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let run = |a: Vec<String>| {
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        let o = run_in(tmp.path(), &a);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    run(args("d", ""));
+    let optimum = |d: &str| -> f64 {
+        let m: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(tmp.path().join(d).join("manifest.json")).unwrap(),
+        )
+        .unwrap();
+        m["optimum"][0]["quality"].as_f64().unwrap()
+    };
+    let true_opt = optimum("d");
+    let cache_dir = tmp.path().join("d/optimum-cache");
+    let cache = std::fs::read_dir(&cache_dir)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let mut c: serde_json::Value = serde_json::from_slice(&std::fs::read(&cache).unwrap()).unwrap();
+    let fake = true_opt * 0.6;
+    c["optimum"]["quality"] = fake.into();
+    c["quality_bits"] = fake.to_bits().into();
+    let tampered = serde_json::to_vec(&c).unwrap();
+    std::fs::write(&cache, &tampered).unwrap();
+    // A fresh sweep into the same directory (the cache stays) and --overwrite.
+    std::fs::remove_file(tmp.path().join("d/runs.jsonl")).unwrap();
+    run(args("d", ""));
+    assert_eq!(optimum("d"), true_opt);
+    std::fs::write(&cache, &tampered).unwrap();
+    run(args("d", "--overwrite"));
+    assert_eq!(optimum("d"), true_opt);
+    for line in lines_of(&tmp.path().join("d/runs.jsonl")) {
+        let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+        assert!(v["quality_pct"].as_f64().unwrap() <= 100.0, "{line}");
+    }
 }
