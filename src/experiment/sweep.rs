@@ -22,6 +22,10 @@ use crate::search::{Algo, Searcher};
 pub const DEFAULT_ALGOS: &[&str] = &["selective", "greedy", "greedy-nocrit", "optimum"];
 /// The default base seed.
 pub const DEFAULT_SEED: u64 = 2026;
+/// Most horizons one sweep takes.
+pub const MAX_HORIZONS: usize = 1024;
+/// Most runs one sweep plans (its run list is held in memory, each run a line of the log).
+pub const MAX_RUNS: u64 = 10_000_000;
 /// Directory of the optimum cache inside a results directory.
 pub const OPTIMUM_CACHE_DIR: &str = "optimum-cache";
 
@@ -124,6 +128,33 @@ impl SweepConfig {
         }
         if self.threads == 0 {
             return bad("--threads must be at least 1".into());
+        }
+        if self.horizons.len() > MAX_HORIZONS {
+            return bad(format!(
+                "{} horizons given; a sweep takes at most {MAX_HORIZONS}",
+                self.horizons.len()
+            ));
+        }
+        // Counted before the run list is built (it is held in memory).
+        let per_mesh: u64 = (self.algos.iter())
+            .map(|a| match a.as_str() {
+                "optimum" => 1,
+                a if has_horizon(a) => self.horizons.len() as u64 * u64::from(self.runs),
+                _ => u64::from(self.baseline_runs),
+            })
+            .sum();
+        let total = per_mesh.saturating_mul(self.meshes.len() as u64);
+        if total > MAX_RUNS {
+            return bad(format!(
+                "the sweep has {total} runs (--runs {}, --baseline-runs {}, {} horizon(s), {} \
+                 algorithm(s), {} mesh(es)); a sweep takes at most {MAX_RUNS}: split it or run \
+                 fewer",
+                self.runs,
+                self.baseline_runs,
+                self.horizons.len(),
+                self.algos.len(),
+                self.meshes.len()
+            ));
         }
         Ok(())
     }

@@ -513,3 +513,72 @@ fn an_edited_optimum_cache_is_recomputed() {
         assert!(v["quality_pct"].as_f64().unwrap() <= 100.0, "{line}");
     }
 }
+
+/// Item 8: sizes that cannot be held are refused before anything is allocated or written,
+/// with the limit (they aborted, exit 134, leaving a manifest and a lock behind).
+#[test]
+fn huge_sizes_are_refused_with_their_limit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (
+            &[
+                "sweep",
+                "--mesh",
+                "sphere",
+                "--horizons",
+                "1..1000000000",
+                "--out",
+                "a",
+            ],
+            "at most 1024",
+        ),
+        (
+            &[
+                "sweep",
+                "--mesh",
+                "sphere",
+                "--algo",
+                "selective",
+                "--runs",
+                "4294967295",
+                "--horizons",
+                "1",
+                "--out",
+                "b",
+            ],
+            "at most 10000000",
+        ),
+        (
+            &[
+                "sweep",
+                "--mesh",
+                "sphere",
+                "--algo",
+                "greedy",
+                "--baseline-runs",
+                "4294967295",
+                "--out",
+                "c",
+            ],
+            "at most 10000000",
+        ),
+        (
+            &[
+                "generate",
+                "grid",
+                "--triangles",
+                "2000000000",
+                "-o",
+                "g.msh",
+            ],
+            "GiB of memory",
+        ),
+    ];
+    for (args, msg) in cases {
+        let o = run_in(tmp.path(), args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(msg), "{args:?}: {}", stderr(&o));
+    }
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert!(left.is_empty(), "{left:?}");
+}
