@@ -27,7 +27,7 @@ pub fn write_atomic(
                 io::ErrorKind::InvalidInput,
                 format!(
                     "exists and is {}, not a regular file: refusing to replace it",
-                    kind_of(&meta)
+                    crate::mesh::file_kind(&meta)
                 ),
             ));
         }
@@ -73,34 +73,6 @@ pub fn write_bytes(path: &Path, bytes: &[u8]) -> io::Result<()> {
 /// not exist yet (or its link dangles: the link is then replaced).
 fn resolve(path: &Path) -> PathBuf {
     std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
-}
-
-/// "a directory", "a FIFO", ... for messages.
-pub fn kind_of(meta: &std::fs::Metadata) -> &'static str {
-    let t = meta.file_type();
-    if t.is_dir() {
-        return "a directory";
-    }
-    if t.is_file() {
-        return "a regular file";
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO (named pipe)";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-        if t.is_char_device() {
-            return "a character device";
-        }
-        if t.is_block_device() {
-            return "a block device";
-        }
-    }
-    "not a regular file"
 }
 
 #[cfg(test)]

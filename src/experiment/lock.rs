@@ -37,7 +37,7 @@ impl DirLock {
                     return Err(ExperimentError::Invalid(format!(
                         "{}: is {}, not a sweep's lock file; remove it (no sweep uses it)",
                         path.display(),
-                        crate::output::kind_of(&meta)
+                        crate::mesh::file_kind(&meta)
                     )));
                 }
             }

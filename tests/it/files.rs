@@ -582,3 +582,55 @@ fn huge_sizes_are_refused_with_their_limit() {
     let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
     assert!(left.is_empty(), "{left:?}");
 }
+
+/// Runs `quadrecomb args` in `dir` under bash with `limits` (ulimit commands); kills it
+/// after `secs` seconds (a hang is a failure, not a stuck test).
+fn run_limited(dir: &Path, limits: &str, args: &[&str], secs: u64) -> Output {
+    let mut child = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!("{limits}; exec \"$0\" \"$@\""))
+        .arg(bin())
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed().as_secs() >= secs {
+            child.kill().unwrap();
+            let _ = child.wait();
+            panic!("{args:?} did not finish in {secs} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Item 10: inputs that never end. A FIFO without a writer (blocked forever), a character
+/// device (`/dev/zero` was read for 8 GB) and a directory are refused as not regular files;
+/// a 2 GB sparse file is called an unknown format from its first bytes, within 1 GB of
+/// address space (it was read whole first).
+#[cfg(unix)]
+#[test]
+fn inputs_that_never_end_are_refused_from_their_first_bytes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut cases: Vec<(String, &str)> = vec![
+        ("/dev/zero".into(), "a character device, not a mesh file"),
+        (".".into(), "a directory, not a mesh file"),
+    ];
+    if mkfifo(&tmp.path().join("fifo.msh")) {
+        cases.push(("fifo.msh".into(), "a FIFO (named pipe), not a mesh file"));
+    }
+    let big = std::fs::File::create(tmp.path().join("big.msh")).unwrap();
+    big.set_len(2 << 30).unwrap();
+    cases.push(("big.msh".into(), "unknown mesh format"));
+    for (input, msg) in &cases {
+        for cmd in ["info", "optimum"] {
+            let o = run_limited(tmp.path(), "ulimit -v 1000000", &[cmd, input], 20);
+            assert_eq!(o.status.code(), Some(2), "{cmd} {input}: {}", stderr(&o));
+            assert!(stderr(&o).contains(msg), "{cmd} {input}: {}", stderr(&o));
+        }
+    }
+}
