@@ -250,6 +250,19 @@ fn optimum_of(results: &Results, mesh: &str) -> Option<f64> {
         .map(|o| o.quality)
 }
 
+/// File-name-safe form of a mesh name: its [`slug`] when that is the name itself, else the
+/// slug and 8 hex digits of the name's hash (`a b` and `a-b` both gave `a-b`, and their
+/// figures overwrote each other).
+fn mesh_slug(mesh: &str) -> String {
+    let s = slug(mesh);
+    if s == mesh {
+        s
+    } else {
+        let h = blake3::hash(mesh.as_bytes()).to_hex();
+        format!("{s}-{}", &h[..8])
+    }
+}
+
 /// File-name-safe form of a label.
 fn slug(s: &str) -> String {
     s.chars()
@@ -505,7 +518,7 @@ fn box_plots(
                     caption.push_str("; the paper reports 1.33 on its Borouchaki mesh.");
                 }
             }
-            let stem = format!("{}-{}-{}", slug(mesh), slug(algo), metric.key());
+            let stem = format!("{}-{}-{}", mesh_slug(mesh), slug(algo), metric.key());
             let svg = boxplot_svg(
                 &format!("{stem}-"),
                 &format!("{mesh}: {algo}"),
@@ -635,7 +648,7 @@ fn pictures(
             caption.push('.');
             let file = format!(
                 "{FIGURES_DIR}/{}-{}-{kind}.svg",
-                slug(mesh),
+                mesh_slug(mesh),
                 slug(&c.label())
             );
             doc.figure(file, svg, caption);

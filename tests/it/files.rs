@@ -634,3 +634,63 @@ fn inputs_that_never_end_are_refused_from_their_first_bytes() {
         }
     }
 }
+
+/// Item 12: mesh names are escaped in report.md (`## Mesh <img src=x onerror=alert(2)>` was
+/// raw HTML there), and meshes whose names slug alike (`a b`, `a-b`) get figures of their
+/// own (both wrote `figures/a-b-*.svg`).
+#[test]
+fn report_escapes_mesh_names_and_keeps_figures_apart() {
+    let tmp = tempfile::tempdir().unwrap();
+    let names = ["a b", "a-b", "<img src=x onerror=alert(2)>"];
+    for (i, n) in names.iter().enumerate() {
+        let file = format!("{n}.msh");
+        let seed = (i + 1).to_string();
+        let args = [
+            "generate",
+            "grid",
+            "--triangles",
+            "60",
+            "--seed",
+            &seed,
+            "-o",
+            &file,
+        ];
+        let o = run_in(tmp.path(), &args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let mut args = vec!["sweep", "--mesh"];
+    let files: Vec<String> = names.iter().map(|n| format!("{n}.msh")).collect();
+    args.extend(files.iter().map(String::as_str));
+    args.extend([
+        "--algo",
+        "selective",
+        "greedy",
+        "--horizons",
+        "1,2",
+        "--runs",
+        "2",
+        "--backend",
+        "cpu",
+        "--out",
+        "d",
+        "-q",
+    ]);
+    let o = run_in(tmp.path(), &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = std::fs::read_to_string(tmp.path().join("d/report.md")).unwrap();
+    let raw = md.match_indices('<').any(|(i, _)| !md[..i].ends_with('\\'));
+    assert!(!raw, "raw HTML in report.md");
+    assert!(
+        md.contains(r"## Mesh \<img src=x onerror=alert(2)\>"),
+        "{md}"
+    );
+    let listed: Vec<String> = lines_of(&tmp.path().join("d/report-files.txt"));
+    // Three box plots and one picture per mesh, none shared.
+    assert_eq!(listed.len(), 3 * 4, "{listed:?}");
+    let unique: std::collections::BTreeSet<_> = listed.iter().collect();
+    assert_eq!(unique.len(), listed.len(), "{listed:?}");
+    for f in &listed {
+        assert!(tmp.path().join("d").join(f).is_file(), "{f}");
+        assert!(md.contains(&format!("]({f})")), "{f} not linked");
+    }
+}
