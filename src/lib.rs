@@ -7,6 +7,7 @@
 pub mod experiment;
 pub mod gpu;
 pub mod mesh;
+pub mod output;
 pub mod quality;
 pub mod report;
 pub mod search;

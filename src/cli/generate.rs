@@ -76,6 +76,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 drop_triangles: a.drop_triangles,
             };
             spec.validate().map_err(|e| BadInput(e.to_string()))?;
+            check_memory(a.triangles)?;
             check_output(&a.output)?;
             let (nx, ny) = spec.cells();
             let what = format!("grid of {nx} x {ny} cells, seed {}", spec.seed);
@@ -122,6 +123,36 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         mesh.vertices.len(),
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// Peak memory of `generate grid` per triangle (measured: 176 bytes at 10^6 and 4 * 10^6
+/// triangles), rounded up.
+const BYTES_PER_TRIANGLE: u64 = 200;
+
+/// Refuses, before allocating, a grid that needs more memory than the machine has (it
+/// aborted allocating instead).
+fn check_memory(triangles: usize) -> Result<(), BadInput> {
+    let Some(total) = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
+        s.lines()
+            .find_map(|l| l.strip_prefix("MemTotal:"))
+            .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+            .map(|kb| kb * 1024)
+    }) else {
+        return Ok(());
+    };
+    let need = (triangles as u64).saturating_mul(BYTES_PER_TRIANGLE);
+    if need > total {
+        let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+        return Err(BadInput(format!(
+            "--triangles {triangles}: generating needs about {:.1} GiB of memory (about \
+             {BYTES_PER_TRIANGLE} bytes per triangle), more than this machine's {:.1} GiB; \
+             at most about {} triangles here",
+            gib(need),
+            gib(total),
+            total / BYTES_PER_TRIANGLE
+        )));
+    }
+    Ok(())
 }
 
 /// Fails early (before generating) if the output cannot be a new .msh file.

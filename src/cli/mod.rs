@@ -172,6 +172,33 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), BadInput> {
     }
 }
 
+/// Refuses an output that is the input mesh file itself, however it is spelled (`./in.msh`,
+/// a symbolic or hard link): the same file by device and inode. Writing it would destroy the
+/// input.
+pub fn check_not_input(output: Option<&std::path::Path>, input: &str) -> Result<(), BadInput> {
+    let Some(out) = output else {
+        return Ok(());
+    };
+    let (Ok(a), Ok(b)) = (std::fs::metadata(out), std::fs::metadata(input)) else {
+        return Ok(());
+    };
+    #[cfg(unix)]
+    let same = {
+        use std::os::unix::fs::MetadataExt;
+        a.dev() == b.dev() && a.ino() == b.ino()
+    };
+    #[cfg(not(unix))]
+    let same = std::fs::canonicalize(out).ok() == std::fs::canonicalize(input).ok();
+    if same {
+        return Err(BadInput(format!(
+            "output {} is the input mesh {input}: refusing to overwrite the input; choose \
+             another -o",
+            out.display()
+        )));
+    }
+    Ok(())
+}
+
 /// `Some(true)` for a `.vtu` path, `Some(false)` for `.msh`, `None` otherwise (any case).
 fn output_kind(path: &std::path::Path) -> Option<bool> {
     let ext = path.extension()?;
@@ -192,38 +219,18 @@ pub fn write_mesh_output(
     mesh: &quadrecomb::mesh::Mesh,
     rec: &quadrecomb::mesh::Recombined,
 ) -> Result<(), BadInput> {
-    use std::io::Write;
-    let fail = |e: &dyn std::fmt::Display| {
+    let vtu = output_kind(path) == Some(true);
+    quadrecomb::output::write_atomic(path, |mut w| {
+        if vtu {
+            quadrecomb::mesh::vtu::write_to(&mut w, mesh, rec)
+        } else {
+            quadrecomb::mesh::msh::write_to(&mut w, mesh, rec)
+        }
+    })
+    .map_err(|e| {
         BadInput(format!(
             "cannot write output {} (through a temporary file beside it): {e}",
             path.display()
         ))
-    };
-    // Through a symbolic link: replace the file it points to, not the link.
-    let resolved = std::fs::canonicalize(path).ok();
-    let path = resolved.as_deref().unwrap_or(path);
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(format!(".tmp-{}", std::process::id()));
-    let tmp = std::path::PathBuf::from(tmp);
-    let written = (|| -> std::io::Result<()> {
-        let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-        if output_kind(path) == Some(true) {
-            quadrecomb::mesh::vtu::write_to(&mut w, mesh, rec)?;
-        } else {
-            quadrecomb::mesh::msh::write_to(&mut w, mesh, rec)?;
-        }
-        w.flush()?;
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        // An existing file keeps its permissions; the data reaches the disk before the
-        // rename makes it the file.
-        if let Ok(meta) = std::fs::metadata(path) {
-            file.set_permissions(meta.permissions())?;
-        }
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    written.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        fail(&e)
     })
 }

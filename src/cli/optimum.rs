@@ -29,6 +29,7 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     super::check_mesh_output(args.output.as_deref())?;
     let rule = args.rule.rule()?;
+    super::check_not_input(args.output.as_deref(), &args.mesh)?;
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
     let table = CandidateTable::build(&mesh).restrict(&mesh, rule);
     let (opt, report) = optimum::solve_certified(&mesh, &table, args.check);

@@ -100,6 +100,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     super::check_mesh_output(args.output.as_deref())?;
     let rule = args.rule.rule()?;
+    super::check_not_input(args.output.as_deref(), &args.mesh)?;
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
     let (table, backend) = eta_table(&mesh, args.backend, rule)?;
     let out = search::run(&mesh, &table, algo, args.seed);

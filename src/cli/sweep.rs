@@ -8,7 +8,7 @@ use anyhow::Context;
 use quadrecomb::experiment::ExperimentError;
 use quadrecomb::experiment::manifest::Shard;
 use quadrecomb::experiment::progress::ProgressMode;
-use quadrecomb::experiment::sweep::{self, DEFAULT_SEED, SweepConfig};
+use quadrecomb::experiment::sweep::{self, DEFAULT_SEED, MAX_HORIZONS, SweepConfig};
 use quadrecomb::gpu::Backend;
 
 use super::BadInput;
@@ -83,8 +83,21 @@ fn parse_horizons(s: &str) -> Result<Horizons, String> {
         if a > b {
             return Err(format!("empty horizon range {s:?}"));
         }
+        // Checked before the range is collected.
+        let n = u64::from(b - a) + 1;
+        if n > MAX_HORIZONS as u64 {
+            return Err(format!(
+                "horizon range {s:?} holds {n} horizons; a sweep takes at most {MAX_HORIZONS}"
+            ));
+        }
         (a..=b).collect()
     } else {
+        let n = s.split(',').count();
+        if n > MAX_HORIZONS {
+            return Err(format!(
+                "{n} horizons given; a sweep takes at most {MAX_HORIZONS}"
+            ));
+        }
         s.split(',')
             .map(num)
             .collect::<Result<Vec<u32>, String>>()?
@@ -224,5 +237,9 @@ mod tests {
         assert!(parse_horizons("0..3").is_err());
         assert!(parse_horizons("5..3").is_err());
         assert!(parse_horizons("a").is_err());
+        // Refused before a billion horizons are collected (it aborted allocating).
+        let err = parse_horizons("1..1000000000").unwrap_err();
+        assert!(err.contains("at most 1024"), "{err}");
+        assert!(parse_horizons("1..1024").is_ok() && parse_horizons("1..1025").is_err());
     }
 }

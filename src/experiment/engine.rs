@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 
 use super::ExperimentError;
 use super::exec::{Outcome, WorkerFactory, execute};
-use super::manifest::{MANIFEST_FILE, Manifest};
+use super::manifest::{MANIFEST_FILE, Manifest, OptimumEntry};
 use super::plan::{Job, execution_order, plan, shard};
 use super::progress::{Progress, ProgressMode};
 use super::record::{RunKey, RunRecord};
@@ -103,63 +103,215 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
     }
 }
 
-/// Checks that `records` are runs of `jobs` (same keys and seeds), each at most once.
-pub(crate) fn check_records(
+/// Checks that the records of `loaded` (read from `path`/runs.jsonl) are runs of `jobs`
+/// (same keys, mesh hash and size, and seeds when `seeds`), each at most once, with values a
+/// run can have ([`check_values`], against the manifest's optimum). Errors give the line.
+pub fn check_records(
     path: &Path,
     manifest: &Manifest,
     jobs: &[Job],
-    records: &[RunRecord],
+    loaded: &store::Loaded,
+    seeds: bool,
 ) -> Result<HashSet<RunKey>, ExperimentError> {
     let planned: BTreeMap<RunKey, &Job> = jobs.iter().map(|j| (j.key(&manifest.spec), j)).collect();
-    let mut seen = HashSet::new();
-    for r in records {
+    let mut seen: BTreeMap<RunKey, usize> = BTreeMap::new();
+    let runs = path.join(RUNS_FILE);
+    for (r, &line) in loaded.records.iter().zip(&loaded.line_numbers) {
         let key = r.key();
         let Some(job) = planned.get(&key) else {
             return Err(ExperimentError::Mismatch {
                 dir: path.to_path_buf(),
-                message: format!("run {key} is not part of this sweep (or of this shard)"),
+                message: format!(
+                    "{}:{line}: run {key} is not part of this sweep (or of this shard)",
+                    runs.display()
+                ),
             });
         };
         let mesh = &manifest.spec.meshes[job.mesh];
-        if r.seed != job.seed || r.mesh_hash != mesh.hash {
+        if (seeds && r.seed != job.seed)
+            || r.mesh_hash != mesh.hash
+            || r.triangles != mesh.triangles
+        {
             return Err(ExperimentError::Mismatch {
                 dir: path.to_path_buf(),
-                message: format!("run {key} has another seed or mesh hash than this sweep derives"),
+                message: format!(
+                    "{}:{line}: run {key} has another seed, mesh hash or triangle count than \
+                     this sweep's",
+                    runs.display()
+                ),
             });
         }
-        if !seen.insert(key.clone()) {
+        check_values(r, manifest.optimum.get(job.mesh)).map_err(|why| {
+            ExperimentError::Corrupt {
+                path: runs.clone(),
+                message: format!("line {line}: run {key}: {why}"),
+            }
+        })?;
+        if let Some(first) = seen.insert(key.clone(), line) {
             return Err(ExperimentError::Corrupt {
-                path: path.join(RUNS_FILE),
-                message: format!("run {key} is recorded twice"),
+                path: runs,
+                message: format!(
+                    "line {line}: run {key} is recorded twice (first on line {first})"
+                ),
             });
         }
     }
-    Ok(seen)
+    Ok(seen.into_keys().collect())
 }
 
-/// Removes what an earlier sweep wrote into `dir` (runs, manifest, summary, report, figures).
+/// Refuses a record whose values no run can have: counts that do not add up, a percentage
+/// out of its range, a non-finite or negative measure, an unknown algorithm, and, against the
+/// mesh's optimum when known: more quads than the optimum's (it pairs as many triangles as
+/// can be paired), a quality above it with as many quads (beyond the rounding of its integer
+/// weights), or a `quality_pct` that is not 100 x quality / optimum. A run with fewer quads
+/// than the optimum may exceed its quality (see docs/search.md); it cannot exceed its quads
+/// (eta is at most 1).
+pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(), String> {
+    let finite = [
+        ("quality", r.quality),
+        ("recombined_pct", r.recombined_pct),
+        ("time_s", r.time_s),
+    ];
+    for (name, v) in finite {
+        if !v.is_finite() || v < 0.0 {
+            return Err(format!("{name} {v} is not a finite non-negative number"));
+        }
+    }
+    if !super::record::ALGO_NAMES.contains(&r.algo.as_str()) {
+        return Err(format!("unknown algorithm {:?}", r.algo));
+    }
+    if super::plan::has_horizon(&r.algo) != r.horizon.is_some() || r.horizon == Some(0) {
+        return Err(format!(
+            "horizon {:?} does not fit algorithm {}",
+            r.horizon, r.algo
+        ));
+    }
+    if 2 * r.quads as u128 + r.triangles_left as u128 != r.triangles as u128 {
+        return Err(format!(
+            "2 x {} quads + {} triangles left is not its {} triangles",
+            r.quads, r.triangles_left, r.triangles
+        ));
+    }
+    if r.recombined_pct > 100.0 + 1e-9 {
+        return Err(format!("recombined_pct {} is above 100", r.recombined_pct));
+    }
+    // Sums of eta in different orders differ in the last bits.
+    let slack = |q: f64| 1e-9 * q.abs().max(1.0);
+    if r.quality > r.quads as f64 + slack(r.quality) {
+        return Err(format!(
+            "quality {} is above its {} quads (eta is at most 1 each)",
+            r.quality, r.quads
+        ));
+    }
+    if let Some(pct) = r.quality_pct {
+        if !pct.is_finite() || pct < 0.0 {
+            return Err(format!(
+                "quality_pct {pct} is not a finite non-negative number"
+            ));
+        }
+    }
+    let Some(opt) = optimum else {
+        return Ok(());
+    };
+    if r.quads > opt.quads {
+        return Err(format!(
+            "{} quads, more than the {} of its mesh's optimum (the most triangle pairs there are)",
+            r.quads, opt.quads
+        ));
+    }
+    // The optimum maximises integer weights round(eta * 2^24): a run with as many quads can
+    // beat it by at most half a unit per quad on each side.
+    let rounding = r.quads as f64 / crate::search::optimum::WEIGHT_SCALE;
+    if r.quads == opt.quads && r.quality > opt.quality + rounding + slack(opt.quality) {
+        return Err(format!(
+            "quality {} is above the exact optimum {} of its mesh, with as many quads",
+            r.quality, opt.quality
+        ));
+    }
+    if let Some(pct) = r.quality_pct {
+        if opt.quality > 0.0
+            && (pct - 100.0 * r.quality / opt.quality).abs() > 1e-6 * pct.abs().max(1.0)
+        {
+            return Err(format!(
+                "quality_pct {pct} is not 100 x quality {} / optimum {}",
+                r.quality, opt.quality
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Removes what an earlier sweep wrote into `dir`, and nothing else: only a directory with a
+/// sweep's manifest is touched, and only the files a sweep names (runs, manifest, summary,
+/// report, and the figures its report listed in [`REPORT_FILES`]); `figures/` goes only if
+/// that leaves it empty. A directory without a manifest keeps everything.
 fn clear_results(dir: &Path) -> Result<(), ExperimentError> {
-    for name in [
-        RUNS_FILE,
-        MANIFEST_FILE,
-        "summary.csv",
-        "summary.json",
-        "report.md",
-        "report.html",
-    ] {
-        match std::fs::remove_file(dir.join(name)) {
+    if !dir.join(MANIFEST_FILE).exists() {
+        return Ok(());
+    }
+    // Refuses a manifest that is not a sweep's (before deleting anything).
+    Manifest::read(dir)?;
+    let mut names: Vec<PathBuf> = report_files(dir)?.into_iter().map(PathBuf::from).collect();
+    names.extend(
+        [
+            REPORT_FILES,
+            RUNS_FILE,
+            MANIFEST_FILE,
+            summary::SUMMARY_CSV,
+            summary::SUMMARY_JSON,
+            "report.md",
+            "report.html",
+        ]
+        .map(PathBuf::from),
+    );
+    for name in names {
+        let path = dir.join(name);
+        match std::fs::remove_file(&path) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(ExperimentError::io(&dir.join(name), e));
+                return Err(ExperimentError::io(&path, e));
             }
             _ => {}
         }
     }
-    match std::fs::remove_dir_all(dir.join("figures")) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(ExperimentError::io(&dir.join("figures"), e))
+    // Only when empty: a file the sweep did not write stays, and so does its directory.
+    let _ = std::fs::remove_dir(dir.join(FIGURES_DIR));
+    Ok(())
+}
+
+/// File in a results directory listing the figures its report wrote, one relative path a
+/// line, so that `--overwrite` and the next report remove those and no other file.
+pub const REPORT_FILES: &str = "report-files.txt";
+/// Sub-directory of a report's figures.
+pub const FIGURES_DIR: &str = "figures";
+
+/// The figures `dir`'s last report wrote (from [`REPORT_FILES`]; none if it is missing).
+/// Only plain `figures/NAME.svg` paths are taken: a line naming anything else is an error,
+/// not a file to delete.
+pub fn report_files(dir: &Path) -> Result<Vec<String>, ExperimentError> {
+    let path = dir.join(REPORT_FILES);
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(ExperimentError::io(&path, e)),
+    };
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let ok = line
+            .strip_prefix("figures/")
+            .and_then(|n| n.strip_suffix(".svg"))
+            .is_some_and(|n| !n.is_empty() && !n.contains(['/', '\\']) && !n.starts_with('.'));
+        if !ok {
+            return Err(ExperimentError::Corrupt {
+                path,
+                message: format!(
+                    "line {}: {line:?} is not a figure a report writes (figures/NAME.svg)",
+                    i + 1
+                ),
+            });
         }
-        _ => Ok(()),
+        out.push(line.to_string());
     }
+    Ok(out)
 }
 
 /// Runs the sweep described by `manifest` (its spec and shard) into `opts.dir`.
@@ -214,7 +366,7 @@ pub fn run(
     manifest.write(dir)?;
 
     let jobs = shard(plan(&manifest.spec), manifest.shard);
-    let done = check_records(dir, manifest, &jobs, &loaded.records)?;
+    let done = check_records(dir, manifest, &jobs, &loaded, true)?;
     let mut todo: Vec<Job> = jobs
         .iter()
         .filter(|j| !done.contains(&j.key(&manifest.spec)))
@@ -237,7 +389,17 @@ pub fn run(
         );
     }
     let result = execute(&todo, opts.threads, factory, cancel, &mut |job, out| {
-        log.append(&make_record(manifest, job, out))?;
+        let rec = make_record(manifest, job, out);
+        // What report and merge would refuse is not recorded: a run that beats the optimum
+        // means the optimum is wrong.
+        check_values(&rec, manifest.optimum.get(job.mesh)).map_err(|why| {
+            ExperimentError::Run(format!(
+                "run {}: {why}: the optimum recorded for its mesh is wrong (an edited \
+                 optimum cache?); run again with --overwrite",
+                rec.key()
+            ))
+        })?;
+        log.append(&rec)?;
         progress.inc();
         Ok(())
     });

@@ -139,10 +139,14 @@ pub(crate) mod tests {
 
     pub(crate) fn fake_outcome(job: &Job) -> Outcome {
         let h = job.horizon.unwrap_or(1);
+        // Values a run can have on the test spec's meshes (10 and 20 triangles, optimum 5
+        // quads): the records are checked when resumed or merged.
+        let triangles = 10 * (job.mesh + 1);
+        let quads = (job.seed % 3) as usize + 2;
         Outcome {
-            quads: (job.seed % 5) as usize + 3,
-            triangles_left: (job.seed % 3) as usize,
-            quality: (job.seed % 1000) as f64 / 100.0,
+            quads,
+            triangles_left: triangles - 2 * quads,
+            quality: quads as f64 * (job.seed % 100) as f64 / 100.0,
             nodes_expanded: u64::from(h) * 10 + job.seed % 7,
             trees: 5,
             decisions: 5,

@@ -83,7 +83,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
         }
         // Every record must be a run of the whole list with the right seed (a shard's records
         // are runs of the whole list too).
-        check_records(p, m, &jobs, &loaded.records)?;
+        check_records(p, m, &jobs, &loaded, true)?;
         for (r, line) in loaded.records.iter().zip(&loaded.lines) {
             if let Some((_, _, j)) = by_key.get(&r.key()) {
                 return Err(ExperimentError::Merge(format!(

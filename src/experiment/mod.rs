@@ -72,13 +72,14 @@ pub enum ExperimentError {
     },
     /// Another live process is writing the results directory.
     #[error(
-        "{dir}: another sweep (process {pid}) is writing there; wait for it, stop it, or choose another --out"
+        "{dir}: another sweep{} is writing there; wait for it, stop it, or choose another --out",
+        pid.map_or(String::new(), |p| format!(" (process {p})"))
     )]
     Busy {
         /// The directory.
         dir: PathBuf,
-        /// The process holding `DIR/.lock`.
-        pid: u32,
+        /// The process holding the lock on `DIR/.lock`, when it could be read.
+        pid: Option<u32>,
     },
     /// Shards cannot be merged: missing, duplicated or foreign runs.
     #[error("merge: {0}")]
@@ -128,13 +129,10 @@ impl ExperimentError {
     }
 }
 
-/// Writes a file through a temporary sibling and a rename, so readers never see half of it.
+/// Writes a file through a temporary sibling and a rename ([`crate::output`]), so readers
+/// never see half of it.
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExperimentError> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, bytes).map_err(|e| ExperimentError::io(&tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| ExperimentError::io(path, e))
+    crate::output::write_bytes(path, bytes).map_err(|e| ExperimentError::io(path, e))
 }
 
 /// Version recorded in records and manifests.

@@ -23,6 +23,8 @@ pub struct Loaded {
     /// The lines the records were parsed from (without newline), to copy them exactly: JSON
     /// float parsing may be off by an ulp, so re-serializing a parsed record could change it.
     pub lines: Vec<String>,
+    /// The 1-based line number of each record in the file, for messages.
+    pub line_numbers: Vec<usize>,
     /// Length in bytes of the complete lines (where appending resumes).
     pub valid_len: u64,
     /// Bytes of a torn last line (no newline), ignored; 0 if none.
@@ -39,6 +41,7 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
     let valid_len = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     let mut records = Vec::new();
     let mut lines = Vec::new();
+    let mut line_numbers = Vec::new();
     for (n, line) in bytes[..valid_len].split(|&b| b == b'\n').enumerate() {
         if line.iter().all(u8::is_ascii_whitespace) {
             continue;
@@ -50,10 +53,12 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
             })?;
         records.push(rec);
         lines.push(String::from_utf8_lossy(line).into_owned());
+        line_numbers.push(n + 1);
     }
     Ok(Loaded {
         records,
         lines,
+        line_numbers,
         valid_len: valid_len as u64,
         torn_bytes: (bytes.len() - valid_len) as u64,
     })

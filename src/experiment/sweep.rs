@@ -22,6 +22,10 @@ use crate::search::{Algo, Searcher};
 pub const DEFAULT_ALGOS: &[&str] = &["selective", "greedy", "greedy-nocrit", "optimum"];
 /// The default base seed.
 pub const DEFAULT_SEED: u64 = 2026;
+/// Most horizons one sweep takes.
+pub const MAX_HORIZONS: usize = 1024;
+/// Most runs one sweep plans (its run list is held in memory, each run a line of the log).
+pub const MAX_RUNS: u64 = 10_000_000;
 /// Directory of the optimum cache inside a results directory.
 pub const OPTIMUM_CACHE_DIR: &str = "optimum-cache";
 
@@ -128,6 +132,33 @@ impl SweepConfig {
         if self.threads == 0 {
             return bad("--threads must be at least 1".into());
         }
+        if self.horizons.len() > MAX_HORIZONS {
+            return bad(format!(
+                "{} horizons given; a sweep takes at most {MAX_HORIZONS}",
+                self.horizons.len()
+            ));
+        }
+        // Counted before the run list is built (it is held in memory).
+        let per_mesh: u64 = (self.algos.iter())
+            .map(|a| match a.as_str() {
+                "optimum" => 1,
+                a if has_horizon(a) => self.horizons.len() as u64 * u64::from(self.runs),
+                _ => u64::from(self.baseline_runs),
+            })
+            .sum();
+        let total = per_mesh.saturating_mul(self.meshes.len() as u64);
+        if total > MAX_RUNS {
+            return bad(format!(
+                "the sweep has {total} runs (--runs {}, --baseline-runs {}, {} horizon(s), {} \
+                 algorithm(s), {} mesh(es)); a sweep takes at most {MAX_RUNS}: split it or run \
+                 fewer",
+                self.runs,
+                self.baseline_runs,
+                self.horizons.len(),
+                self.algos.len(),
+                self.meshes.len()
+            ));
+        }
         Ok(())
     }
 }
@@ -203,7 +234,13 @@ pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
         .collect();
     let mut optimum = Vec::new();
     for ((mesh, table), entry) in meshes.iter().zip(&tables).zip(&entries) {
-        optimum.push(cached_optimum(&config.out, mesh, table, entry)?);
+        optimum.push(cached_optimum(
+            &config.out,
+            mesh,
+            table,
+            entry,
+            config.overwrite,
+        )?);
     }
     let manifest = Manifest {
         version: super::VERSION.to_string(),
@@ -237,27 +274,34 @@ pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
 }
 
 /// The optimum of `mesh` with `table`'s eta: read from `out/optimum-cache/<mesh hash>.json`
-/// when it was computed from the same eta, else computed and written there.
+/// when it was computed from the same eta by the same version and its matching checks out
+/// ([`CachedOptimum::verify`]), else (and always with `recompute`) computed and written there.
 pub fn cached_optimum(
     out: &Path,
     mesh: &Mesh,
     table: &CandidateTable,
     entry: &MeshEntry,
+    recompute: bool,
 ) -> Result<OptimumEntry, ExperimentError> {
     let dir = out.join(OPTIMUM_CACHE_DIR);
     let path = dir.join(format!("{}.json", entry.hash));
     let eta = eta_hash(&table.eta);
-    if let Ok(text) = std::fs::read_to_string(&path) {
+    let text = (!recompute)
+        .then(|| std::fs::read_to_string(&path).ok())
+        .flatten();
+    if let Some(text) = text {
         if let Ok(cached) = serde_json::from_str::<CachedOptimum>(&text) {
-            // Caches written before the element figures were recorded lack them.
-            let complete = cached.optimum.quads == 0 || cached.optimum.elements.worst.is_some();
-            if cached.optimum.mesh_hash == entry.hash && cached.optimum.eta_hash == eta && complete
+            if cached.optimum.mesh_hash == entry.hash
+                && cached.optimum.eta_hash == eta
+                && cached.verify(mesh, table)
             {
                 return Ok(OptimumEntry {
                     mesh: entry.name.clone(),
                     // JSON parsing of floats may be off by an ulp: restore the exact value,
                     // so that quality_pct is bit-identical whether the optimum was cached.
                     quality: f64::from_bits(cached.quality_bits),
+                    // From the verified matching, bit for bit as when it was solved.
+                    elements: ElementQuality::of_chosen(table, &cached.chosen),
                     ..cached.optimum
                 });
             }
@@ -278,17 +322,53 @@ pub fn cached_optimum(
     let cached = CachedOptimum {
         quality_bits: found.quality.to_bits(),
         optimum: found.clone(),
+        solver: super::VERSION.to_string(),
+        chosen: opt.chosen,
     };
     let text = serde_json::to_string_pretty(&cached).expect("serializes");
     super::write_atomic(&path, format!("{text}\n").as_bytes())?;
     Ok(found)
 }
 
-/// An optimum cache file: the entry and the exact bits of its quality.
+/// An optimum cache file: the entry, the exact bits of its quality, the version that solved
+/// it and the matching itself (candidate indices, ascending), so that it can be checked.
 #[derive(Debug, serde::Serialize, serde::Deserialize)]
 struct CachedOptimum {
     optimum: OptimumEntry,
     quality_bits: u64,
+    /// quadrecomb version that computed it (absent in caches written before: recomputed).
+    #[serde(default)]
+    solver: String,
+    #[serde(default)]
+    chosen: Vec<u32>,
+}
+
+impl CachedOptimum {
+    /// Whether this cache can be trusted for `mesh` and `table`: written by this version,
+    /// and its matching is one (candidates of the table, no triangle twice) whose eta sums
+    /// to the recorded quality bit for bit, with the recorded counts. An edited quality fails
+    /// here; a matching that passes is a real one, so its quality is not above the optimum.
+    fn verify(&self, mesh: &Mesh, table: &CandidateTable) -> bool {
+        let o = &self.optimum;
+        let nt = mesh.num_triangles();
+        let mut used = vec![false; nt];
+        let ascending = self.chosen.windows(2).all(|w| w[0] < w[1]);
+        let disjoint = self.chosen.iter().all(|&c| {
+            table.pairs.get(c as usize).is_some_and(|&[a, b]| {
+                let fresh = !used[a as usize] && !used[b as usize];
+                used[a as usize] = true;
+                used[b as usize] = true;
+                fresh
+            })
+        });
+        self.solver == super::VERSION
+            && ascending
+            && disjoint
+            && o.quads == self.chosen.len()
+            && 2 * o.quads + o.triangles_left == nt
+            && o.quality.to_bits() == self.quality_bits
+            && table.quality_of(&self.chosen).to_bits() == self.quality_bits
+    }
 }
 
 /// Runs searches (and reports the precomputed optimum) for the engine.

@@ -28,15 +28,66 @@ pub fn source(spec: &str) -> Result<Source, ReadError> {
             });
         }
     }
-    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_file(path)?;
     Ok(Source {
         path: path.to_path_buf(),
         builtin: false,
         bytes: Cow::Owned(bytes),
     })
+}
+
+/// Bytes read before the format is known.
+const SNIFF_BYTES: usize = 64 * 1024;
+
+/// Reads a mesh file: only a regular file (a FIFO without a writer blocked forever,
+/// `/dev/zero` was read for gigabytes), and only as many bytes as it had when opened; the
+/// rest is read only once its first bytes look like a MSH file (a 2 GB file of zeros was
+/// read whole before being called an unknown format).
+pub fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
+    use std::io::Read;
+    let io = |source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let not_regular = |meta: &std::fs::Metadata| {
+        io(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "is {}, not a mesh file (only regular files are read)",
+                file_kind(meta)
+            ),
+        ))
+    };
+    // Checked before opening: opening a FIFO waits for a writer.
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_regular(&meta));
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_regular(&meta));
+    }
+    let len = meta.len();
+    let mut reader = file.take(len);
+    let mut bytes = Vec::new();
+    (&mut reader)
+        .take(SNIFF_BYTES as u64)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    let eof = (bytes.len() as u64) < SNIFF_BYTES as u64 || bytes.len() as u64 == len;
+    let head = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+    if let Some(start) = head.iter().position(|c| !c.is_ascii_whitespace()) {
+        let known = head.len() - start >= b"$MeshFormat".len() || eof;
+        if known && !msh::is_msh(head) {
+            return Err(ReadError::UnknownFormat {
+                path: path.to_path_buf(),
+                builtins: builtin::NAMES.join(", "),
+            });
+        }
+    }
+    reader.read_to_end(&mut bytes).map_err(io)?;
+    Ok(bytes)
 }
 
 impl Source {
@@ -53,4 +104,32 @@ impl Source {
 /// [`builtin::NAMES`]). A path that exists wins over a built-in of the same name.
 pub fn load(spec: &str) -> Result<Mesh, ReadError> {
     source(spec)?.mesh()
+}
+
+/// What a file is, for messages: "a directory", "a FIFO (named pipe)", ...
+pub fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    let t = meta.file_type();
+    if t.is_dir() {
+        return "a directory";
+    }
+    if t.is_file() {
+        return "a regular file";
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+    }
+    "not a regular file"
 }

@@ -10,7 +10,7 @@ pub mod order;
 pub(crate) mod topology;
 pub mod vtu;
 
-pub use load::{Source, load, source};
+pub use load::{Source, file_kind, load, read_file, source};
 
 pub use error::{MeshError, ReadError};
 pub use topology::Topology;

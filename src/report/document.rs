@@ -58,9 +58,22 @@ impl Document {
         self.blocks.push(Block::Table { header, rows });
     }
 
-    /// Appends a figure.
+    /// Appends a figure. A file name already taken by another figure gets a `-2`, `-3`, ...
+    /// before its extension, so that no figure overwrites another.
     pub fn figure(&mut self, file: String, svg: String, caption: String) {
-        self.blocks.push(Block::Figure { file, svg, caption });
+        let taken = |f: &str| self.figures().any(|(g, _)| g == f);
+        let mut unique = file.clone();
+        let (stem, ext) = file.rsplit_once('.').unwrap_or((&file, ""));
+        let mut k = 2;
+        while taken(&unique) {
+            unique = format!("{stem}-{k}.{ext}");
+            k += 1;
+        }
+        self.blocks.push(Block::Figure {
+            file: unique,
+            svg,
+            caption,
+        });
     }
 
     /// The figures, as (file, svg).
@@ -79,23 +92,23 @@ impl Document {
                 Block::Heading(level, text) => {
                     out.push_str(&"#".repeat(*level as usize));
                     out.push(' ');
-                    out.push_str(text);
+                    out.push_str(&md_escape(text));
                     out.push_str("\n\n");
                 }
                 Block::Para(text) => {
-                    out.push_str(text);
+                    out.push_str(&md_escape(text));
                     out.push_str("\n\n");
                 }
                 Block::List(items) => {
                     for i in items {
                         out.push_str("- ");
-                        out.push_str(i);
+                        out.push_str(&md_escape(i));
                         out.push('\n');
                     }
                     out.push('\n');
                 }
                 Block::Table { header, rows } => {
-                    let cell = |s: &str| s.replace('|', "\\|");
+                    let cell = |s: &str| md_escape(s);
                     out.push_str("| ");
                     out.push_str(
                         &header
@@ -120,8 +133,8 @@ impl Document {
                     let alt = std::path::Path::new(file)
                         .file_stem()
                         .map_or(file.clone(), |s| s.to_string_lossy().into_owned());
-                    out.push_str(&format!("![{alt}]({file})\n\n"));
-                    out.push_str(&format!("*{caption}*\n\n"));
+                    out.push_str(&format!("![{}]({file})\n\n", md_escape(&alt)));
+                    out.push_str(&format!("*{}*\n\n", md_escape(caption)));
                 }
             }
         }
@@ -182,6 +195,40 @@ impl Document {
         out.push_str("</body>\n</html>\n");
         out
     }
+}
+
+/// Plain text as Markdown that shows it as it is: every character Markdown or HTML could
+/// read as markup (emphasis, code, links, images, raw HTML, entities, table cells, headings)
+/// is backslash-escaped, a leading list or heading marker too, and line breaks become
+/// spaces. Mesh names and directories come from the user (`<img src=x onerror=...>` as a
+/// mesh name was raw HTML in report.md).
+pub fn md_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for (i, c) in s.chars().enumerate() {
+        match c {
+            '\\' | '`' | '*' | '_' | '{' | '}' | '[' | ']' | '<' | '>' | '#' | '|' | '!' | '~'
+            | '&' => {
+                out.push('\\');
+                out.push(c);
+            }
+            '-' | '+' | '=' if i == 0 => {
+                out.push('\\');
+                out.push(c);
+            }
+            '\n' | '\r' => out.push(' '),
+            _ => out.push(c),
+        }
+    }
+    // "1. x" or "1) x" at the start is an ordered list ("85.1" is not).
+    let digits = out.chars().take_while(char::is_ascii_digit).count();
+    let mut after = out[digits..].chars();
+    if digits > 0
+        && matches!(after.next(), Some('.' | ')'))
+        && after.next().is_none_or(|c| c == ' ' || c == '\t')
+    {
+        out.insert(digits, '\\');
+    }
+    out
 }
 
 /// The SVG without an XML declaration (not allowed inside HTML).

@@ -101,12 +101,13 @@ pub struct ReportPaths {
     pub figures: Vec<PathBuf>,
 }
 
-/// Sub-directory of the figures.
-pub const FIGURES_DIR: &str = "figures";
+pub use crate::experiment::engine::FIGURES_DIR;
 
 /// Reads `dir`'s results and writes `dir/report.md`, `dir/report.html` and `dir/figures/*.svg`.
 pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportError> {
     let results = Results::read(dir)?;
+    // The summary follows the runs it is made of (it was left stale after an edit).
+    crate::experiment::summary::write(dir, &results.runs())?;
     let other = match &opts.compare {
         Some(d) => Some(Results::read(d)?),
         None => None,
@@ -118,17 +119,30 @@ pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportErro
         move |source| ReportError::Io { path, source }
     };
     std::fs::create_dir_all(&fig_dir).map_err(io(&fig_dir))?;
+    let earlier = crate::experiment::engine::report_files(dir)?;
     let mut figures = Vec::new();
+    let mut list = String::new();
     for (file, svg) in doc.figures() {
         let path = dir.join(file);
-        std::fs::write(&path, svg).map_err(io(&path))?;
+        crate::output::write_bytes(&path, svg.as_bytes()).map_err(io(&path))?;
         figures.push(path);
+        list.push_str(file);
+        list.push('\n');
+    }
+    // The list of what this report wrote (what `sweep --overwrite` may delete), then the
+    // figures of the earlier report that this one no longer draws.
+    let listed = dir.join(crate::experiment::engine::REPORT_FILES);
+    crate::output::write_bytes(&listed, list.as_bytes()).map_err(io(&listed))?;
+    for old in earlier {
+        if !list.lines().any(|l| l == old) {
+            let _ = std::fs::remove_file(dir.join(old));
+        }
     }
     let markdown = dir.join("report.md");
-    std::fs::write(&markdown, doc.to_markdown()).map_err(io(&markdown))?;
+    crate::output::write_bytes(&markdown, doc.to_markdown().as_bytes()).map_err(io(&markdown))?;
     let html = dir.join("report.html");
     let title = format!("quadrecomb report: {}", dir.display());
-    std::fs::write(&html, doc.to_html(&title)).map_err(io(&html))?;
+    crate::output::write_bytes(&html, doc.to_html(&title).as_bytes()).map_err(io(&html))?;
     Ok(ReportPaths {
         markdown,
         html,
@@ -241,6 +255,19 @@ fn optimum_of(results: &Results, mesh: &str) -> Option<f64> {
         .iter()
         .find(|o| o.mesh == mesh)
         .map(|o| o.quality)
+}
+
+/// File-name-safe form of a mesh name: its [`slug`] when that is the name itself, else the
+/// slug and 8 hex digits of the name's hash (`a b` and `a-b` both gave `a-b`, and their
+/// figures overwrote each other).
+fn mesh_slug(mesh: &str) -> String {
+    let s = slug(mesh);
+    if s == mesh {
+        s
+    } else {
+        let h = blake3::hash(mesh.as_bytes()).to_hex();
+        format!("{s}-{}", &h[..8])
+    }
 }
 
 /// File-name-safe form of a label.
@@ -548,7 +575,7 @@ fn box_plots(
                     caption.push_str("; the paper reports 1.33 on its Borouchaki mesh.");
                 }
             }
-            let stem = format!("{}-{}-{}", slug(mesh), slug(algo), metric.key());
+            let stem = format!("{}-{}-{}", mesh_slug(mesh), slug(algo), metric.key());
             let svg = boxplot_svg(
                 &format!("{stem}-"),
                 &format!("{mesh}: {algo}"),
@@ -678,7 +705,7 @@ fn pictures(
             caption.push('.');
             let file = format!(
                 "{FIGURES_DIR}/{}-{}-{kind}.svg",
-                slug(mesh),
+                mesh_slug(mesh),
                 slug(&c.label())
             );
             doc.figure(file, svg, caption);

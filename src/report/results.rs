@@ -108,12 +108,18 @@ impl Results {
         } else {
             None
         };
+        check(dir, manifest.as_ref(), &loaded)?;
         Ok(Results::from_runs(
             dir,
             loaded.records,
             manifest,
             loaded.torn_bytes,
         ))
+    }
+
+    /// Every run, in configuration order.
+    pub fn runs(&self) -> Vec<Run> {
+        self.groups.values().flatten().cloned().collect()
     }
 
     /// Groups `runs` (already read) by configuration.
@@ -166,6 +172,41 @@ impl Results {
     pub fn num_runs(&self) -> usize {
         self.groups.values().map(Vec::len).sum()
     }
+}
+
+/// Refuses records the report must not believe: with a manifest, a run that is not one of
+/// its sweep's configurations (mesh, algorithm, horizon, run index), of another mesh (hash or
+/// size), or above the recorded optimum; without one, values no run can have; in both, a run
+/// recorded twice. (Seeds are checked where runs are resumed or merged, not here.)
+fn check(
+    dir: &Path,
+    manifest: Option<&manifest::Manifest>,
+    loaded: &store::Loaded,
+) -> Result<(), ReportError> {
+    use crate::experiment::ExperimentError;
+    if let Some(m) = manifest {
+        let jobs = crate::experiment::plan::plan(&m.spec);
+        crate::experiment::engine::check_records(dir, m, &jobs, loaded, false)?;
+        return Ok(());
+    }
+    let path = dir.join(store::RUNS_FILE);
+    let mut seen = std::collections::HashMap::new();
+    for (r, &line) in loaded.records.iter().zip(&loaded.line_numbers) {
+        let corrupt = |message: String| ExperimentError::Corrupt {
+            path: path.clone(),
+            message,
+        };
+        crate::experiment::engine::check_values(r, None)
+            .map_err(|why| corrupt(format!("line {line}: run {}: {why}", r.key())))?;
+        if let Some(first) = seen.insert(r.key(), line) {
+            return Err(corrupt(format!(
+                "line {line}: run {} is recorded twice (first on line {first})",
+                r.key()
+            ))
+            .into());
+        }
+    }
+    Ok(())
 }
 
 /// The measures the report summarizes and compares.

@@ -263,9 +263,14 @@ fn overwrite_replaces_an_earlier_sweep_with_another_configuration() {
             .status
             .success()
     );
-    let figure = dir.join("out/figures/stale.svg");
-    std::fs::create_dir_all(figure.parent().unwrap()).unwrap();
-    std::fs::write(&figure, "<svg/>").unwrap();
+    // The sweep's report listed its figures: --overwrite removes those (and keeps a file
+    // it did not write).
+    assert!(run_in(dir, &["report", "out", "--no-pictures"]).status.success());
+    let listed = std::fs::read_to_string(dir.join("out/report-files.txt")).unwrap();
+    let figure = dir.join("out").join(listed.lines().next().unwrap());
+    assert!(figure.is_file());
+    let mine = dir.join("out/figures/mine.svg");
+    std::fs::write(&mine, "<svg/>").unwrap();
     let args = sweep_args(&mesh, "out", 3, "1..2");
     let refused = sweep(dir, &args, &[]);
     assert_eq!(refused.status.code(), Some(2));
@@ -278,6 +283,7 @@ fn overwrite_replaces_an_earlier_sweep_with_another_configuration() {
     let replaced = sweep(dir, &args, &["--overwrite"]);
     assert!(replaced.status.success(), "{}", stderr(&replaced));
     assert!(!figure.exists(), "old figures are removed");
+    assert!(mine.exists(), "a file the sweep did not write is kept");
     let fresh = sweep(dir, &sweep_args(&mesh, "fresh", 3, "1..2"), &[]);
     assert!(fresh.status.success());
     assert_same(

@@ -7,9 +7,13 @@ use std::process::{Command, Output};
 /// The seed every randomized test starts from.
 pub const SEED: u64 = 0x5EED_2026;
 
-/// The built `quadrecomb` binary.
+/// The built `quadrecomb` binary, or the one `QUADRECOMB_TEST_BIN` names (to check that a
+/// regression test fails on an older build).
 pub fn bin() -> PathBuf {
-    PathBuf::from(env!("CARGO_BIN_EXE_quadrecomb"))
+    std::env::var_os("QUADRECOMB_TEST_BIN").map_or_else(
+        || PathBuf::from(env!("CARGO_BIN_EXE_quadrecomb")),
+        PathBuf::from,
+    )
 }
 
 /// Runs `quadrecomb args...` in `dir` and returns its output.

@@ -147,10 +147,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
 
 /// Reads and validates a MSH file.
 pub fn read(path: &Path) -> Result<Mesh, ReadError> {
-    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = crate::mesh::load::read_file(path)?;
     parse(path, &bytes)?.into_mesh(path)
 }
 

@@ -1,0 +1,142 @@
+//! Writing a file whole or not at all: every file quadrecomb writes (meshes, manifests,
+//! summaries, the optimum cache, reports and figures) goes through [`write_atomic`].
+//!
+//! The content goes to a temporary file created exclusively, under a random name, in the
+//! target's own directory (so nobody can plant a link at a predictable name and make the
+//! write land elsewhere), reaches the disk, and is renamed over the target. A failed write
+//! (a full disk, a kill) leaves the earlier file as it was and removes the temporary.
+
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+/// Writes the bytes produced by `fill` to `path` atomically.
+///
+/// A symbolic link at `path` is followed: the file it points to is replaced, not the link.
+/// An existing file keeps its permissions; a new one gets the usual `0666 & !umask`. An
+/// existing directory, FIFO, socket or device at `path` is refused (replacing a device node
+/// with a regular file is never what was meant). Errors do not name `path`: callers add it.
+pub fn write_atomic(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> io::Result<()> {
+    let target = resolve(path);
+    let existing = match std::fs::metadata(&target) {
+        Ok(meta) if meta.is_file() => Some(meta.permissions()),
+        Ok(meta) => {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "exists and is {}, not a regular file: refusing to replace it",
+                    crate::mesh::file_kind(&meta)
+                ),
+            ));
+        }
+        Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+        Err(e) => return Err(e),
+    };
+    let dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = target
+        .file_name()
+        .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
+    let prefix = format!(".{name}.");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    if existing.is_none() {
+        use std::os::unix::fs::PermissionsExt;
+        // Masked by the umask at creation, as for any new file.
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    // Dropping `tmp` on any error below removes the temporary.
+    let tmp = builder.tempfile_in(dir)?;
+    let mut w = io::BufWriter::new(tmp);
+    fill(&mut w)?;
+    w.flush()?;
+    let tmp = w.into_inner().map_err(|e| e.into_error())?;
+    if let Some(perm) = existing {
+        tmp.as_file().set_permissions(perm)?;
+    }
+    tmp.as_file().sync_all()?;
+    tmp.persist(&target).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// [`write_atomic`] of bytes held in memory.
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_atomic(path, |w| w.write_all(bytes))
+}
+
+/// The file a path names once its symbolic links are followed; the path itself when it does
+/// not exist yet (or its link dangles: the link is then replaced).
+fn resolve(path: &Path) -> PathBuf {
+    std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn leftovers(dir: &Path) -> Vec<String> {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".tmp"))
+            .collect()
+    }
+
+    #[test]
+    fn a_failed_write_keeps_the_old_file_and_removes_its_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("report.md");
+        write_bytes(&path, b"good report\n").unwrap();
+        let err = write_atomic(&path, |w| {
+            w.write_all(b"half a rep")?;
+            Err(io::Error::other("disk full"))
+        })
+        .unwrap_err();
+        assert_eq!(err.to_string(), "disk full");
+        assert_eq!(std::fs::read(&path).unwrap(), b"good report\n");
+        assert!(
+            leftovers(dir.path()).is_empty(),
+            "{:?}",
+            leftovers(dir.path())
+        );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn links_are_followed_modes_kept_and_special_files_refused() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.msh");
+        std::fs::write(&real, "old").unwrap();
+        std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o640)).unwrap();
+        let link = dir.path().join("link.msh");
+        std::os::unix::fs::symlink(&real, &link).unwrap();
+        write_bytes(&link, b"new").unwrap();
+        assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+        let mode = std::fs::metadata(&real).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640);
+
+        let fifo = dir.path().join("fifo.msh");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if made.is_ok_and(|s| s.success()) {
+            let err = write_bytes(&fifo, b"x").unwrap_err().to_string();
+            assert!(err.contains("a FIFO"), "{err}");
+            use std::os::unix::fs::FileTypeExt;
+            assert!(
+                std::fs::symlink_metadata(&fifo)
+                    .unwrap()
+                    .file_type()
+                    .is_fifo()
+            );
+        }
+        let err = write_bytes(Path::new("/dev/null"), b"x").unwrap_err();
+        assert!(err.to_string().contains("character device"), "{err}");
+        assert!(leftovers(dir.path()).is_empty());
+    }
+}

@@ -1,0 +1,696 @@
+//! Reliability of what the CLI reads and writes (issue 26): outputs written whole or not at
+//! all, never over the input or a special file; one sweep per directory; records checked
+//! before they are believed; bad sizes and inputs refused with a message.
+
+use crate::util::{bin, run_in};
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A small sweep (sphere, selective h = 1, 2 and greedy) into `dir/name`, with its report.
+fn small_sweep(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
+    let mut args = vec![
+        "sweep",
+        "--mesh",
+        "sphere",
+        "--algo",
+        "selective",
+        "greedy",
+        "--horizons",
+        "1,2",
+        "--runs",
+        "3",
+        "--backend",
+        "cpu",
+        "--out",
+        name,
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    let o = run_in(dir, &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    dir.join(name)
+}
+
+/// Every regular file under `dir` (relative path, content), sorted.
+fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().into_owned();
+                out.push((rel, std::fs::read(&p).unwrap_or_default()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn names(snap: &[(String, Vec<u8>)]) -> Vec<&str> {
+    snap.iter().map(|(n, _)| n.as_str()).collect()
+}
+
+#[cfg(unix)]
+fn mkfifo(path: &Path) -> bool {
+    std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// Item 5: a report that runs out of space (here a file size limit: writes beyond 10 KiB
+/// fail with EFBIG, as on a full disk) leaves the earlier report whole and no temporary.
+#[cfg(unix)]
+#[test]
+fn a_report_that_cannot_be_written_leaves_the_earlier_one_whole() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = small_sweep(tmp.path(), "d", &[]);
+    let before = snapshot(&dir);
+    assert!(
+        names(&before).contains(&"report.md"),
+        "{:?}",
+        names(&before)
+    );
+    let o = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "trap '' XFSZ; ulimit -f 10; exec {} report d --no-pictures",
+            bin().display()
+        ))
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    assert!(!o.status.success(), "the write should have failed");
+    assert!(stderr(&o).contains("File too large"), "{}", stderr(&o));
+    let after = snapshot(&dir);
+    assert_eq!(names(&after), names(&before));
+    assert!(after == before, "a file changed after a failed report");
+}
+
+/// Item 4: the output path is a FIFO (or a device): it is refused, not replaced by a
+/// regular file, and no temporary is left.
+#[cfg(unix)]
+#[test]
+fn an_output_that_is_a_fifo_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let fifo = tmp.path().join("out.msh");
+    if !mkfifo(&fifo) {
+        eprintln!("skipping: mkfifo is not available");
+        return;
+    }
+    let o = run_in(
+        tmp.path(),
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "greedy",
+            "--no-optimum",
+            "-o",
+            "out.msh",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("FIFO"), "{}", stderr(&o));
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::symlink_metadata(&fifo)
+            .unwrap()
+            .file_type()
+            .is_fifo()
+    );
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert_eq!(left.len(), 1, "a temporary was left behind");
+}
+
+/// Item 3: six sweeps with `--resume` started at once into one directory, 40 times. One
+/// holds the directory's lock, the others are refused at once (exit 2, "another sweep") or
+/// find the work done; no line of `runs.jsonl` is ever torn or interleaved, no run is
+/// recorded twice, and the optimum cache (written by each sweep before it locks) is never
+/// half-written. The PID-file lock of before let two sweeps in at once ("{"m{"mesh": ...").
+#[test]
+fn concurrent_sweeps_never_interleave_records() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run_in(
+        tmp.path(),
+        &[
+            "generate",
+            "grid",
+            "--triangles",
+            "200",
+            "--seed",
+            "7",
+            "-o",
+            "g.msh",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let planned = 3 * 64 + 1; // selective h = 1..3, 64 runs each, and greedy once
+    for round in 0..40 {
+        let out = format!("d{round}");
+        let args = [
+            "sweep",
+            "--mesh",
+            "g.msh",
+            "--algo",
+            "selective",
+            "greedy",
+            "--horizons",
+            "1..3",
+            "--runs",
+            "64",
+            "--threads",
+            "1",
+            "--backend",
+            "cpu",
+            "--out",
+            &out,
+            "-q",
+            "--no-report",
+            "--resume",
+        ];
+        let children: Vec<_> = (0..6)
+            .map(|_| {
+                std::process::Command::new(bin())
+                    .args(args)
+                    .current_dir(tmp.path())
+                    .stdout(std::process::Stdio::null())
+                    .stderr(std::process::Stdio::piped())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        let mut ok = 0;
+        for c in children {
+            let o = c.wait_with_output().unwrap();
+            match o.status.code() {
+                Some(0) => ok += 1,
+                Some(2) if stderr(&o).contains("another sweep") => {}
+                _ => panic!("round {round}: {:?}: {}", o.status, stderr(&o)),
+            }
+        }
+        assert!(ok >= 1, "round {round}: every sweep was refused");
+        let text = std::fs::read_to_string(tmp.path().join(&out).join("runs.jsonl")).unwrap();
+        let mut keys = std::collections::HashSet::new();
+        for (i, line) in text.lines().enumerate() {
+            let rec: serde_json::Value = serde_json::from_str(line)
+                .unwrap_or_else(|e| panic!("round {round}, line {}: {e}: {line}", i + 1));
+            let key = (
+                rec["algo"].clone(),
+                rec["horizon"].clone(),
+                rec["run"].clone(),
+            );
+            assert!(
+                keys.insert(format!("{key:?}")),
+                "round {round}: {line} twice"
+            );
+        }
+        assert!(text.ends_with('\n'));
+        assert_eq!(keys.len(), planned, "round {round}");
+        assert!(!tmp.path().join(&out).join(".lock").exists());
+    }
+}
+
+/// Item 1: `-o` naming the input, as given, as `./in.msh`, through a symbolic link or a hard
+/// link, is refused (exit 2) and the input is left untouched; another name is fine.
+#[cfg(unix)]
+#[test]
+fn an_output_that_is_the_input_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run_in(
+        tmp.path(),
+        &[
+            "generate",
+            "grid",
+            "--triangles",
+            "50",
+            "--seed",
+            "1",
+            "-o",
+            "in.msh",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::os::unix::fs::symlink("in.msh", tmp.path().join("link.msh")).unwrap();
+    std::fs::hard_link(tmp.path().join("in.msh"), tmp.path().join("hard.msh")).unwrap();
+    let input = std::fs::read(tmp.path().join("in.msh")).unwrap();
+    for cmd in [
+        &["recombine", "in.msh", "--algo", "greedy"][..],
+        &["optimum", "in.msh"],
+    ] {
+        for out in ["in.msh", "./in.msh", "link.msh", "hard.msh"] {
+            let mut args = cmd.to_vec();
+            args.extend(["-o", out]);
+            let o = run_in(tmp.path(), &args);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+            assert!(stderr(&o).contains("is the input mesh"), "{}", stderr(&o));
+            assert_eq!(std::fs::read(tmp.path().join("in.msh")).unwrap(), input);
+        }
+    }
+    let o = run_in(
+        tmp.path(),
+        &["recombine", "in.msh", "--algo", "greedy", "-o", "out.msh"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Item 2: `sweep --overwrite` into a directory that was never a sweep's deletes nothing of
+/// it; into a sweep's directory it deletes the sweep's files and the figures its report
+/// listed, nothing else (a file of the user's in `figures/` stays).
+#[test]
+fn overwrite_deletes_only_what_a_sweep_wrote() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("p");
+    std::fs::create_dir_all(p.join("figures/sub")).unwrap();
+    std::fs::write(p.join("figures/sub/fig1.pdf"), "x").unwrap();
+    std::fs::write(p.join("report.md"), "n").unwrap();
+    std::fs::write(p.join("summary.csv"), "mine").unwrap();
+    let before = snapshot(&p);
+    let args = [
+        "sweep",
+        "--mesh",
+        "sphere",
+        "--algo",
+        "greedy",
+        "--horizons",
+        "1",
+        "--runs",
+        "1",
+        "--overwrite",
+        "--out",
+        "p",
+        "--no-report",
+        "-q",
+        "--backend",
+        "cpu",
+    ];
+    let o = run_in(tmp.path(), &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let after = snapshot(&p);
+    for (name, bytes) in &before {
+        if name != "summary.csv" {
+            assert!(
+                after.contains(&(name.clone(), bytes.clone())),
+                "{name} was touched"
+            );
+        }
+    }
+
+    // A sweep's directory with a report, and a file of the user's among its figures.
+    let d = small_sweep(tmp.path(), "d", &[]);
+    let figures = names(&snapshot(&d.join("figures")))
+        .iter()
+        .map(|s| s.to_string())
+        .collect::<Vec<_>>();
+    assert!(figures.len() >= 3, "{figures:?}");
+    std::fs::write(d.join("figures/mine.pdf"), "keep").unwrap();
+    std::fs::write(d.join("notes.txt"), "keep").unwrap();
+    let o = run_in(
+        tmp.path(),
+        &[
+            "sweep",
+            "--mesh",
+            "sphere",
+            "--algo",
+            "greedy",
+            "--out",
+            "d",
+            "--overwrite",
+            "--no-report",
+            "-q",
+            "--backend",
+            "cpu",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let left = snapshot(&d);
+    let left = names(&left);
+    assert!(
+        left.contains(&"figures/mine.pdf") && left.contains(&"notes.txt"),
+        "{left:?}"
+    );
+    for f in &figures {
+        assert!(
+            !left.contains(&format!("figures/{f}").as_str()),
+            "{f} left: {left:?}"
+        );
+    }
+    assert!(!left.contains(&"report.md"), "{left:?}");
+}
+
+fn lines_of(path: &Path) -> Vec<String> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect()
+}
+
+fn edit_line(line: &str, f: impl FnOnce(&mut serde_json::Value)) -> String {
+    let mut v: serde_json::Value = serde_json::from_str(line).unwrap();
+    f(&mut v);
+    serde_json::to_string(&v).unwrap()
+}
+
+/// Item 6: `report` and `merge` refuse records no run of the sweep can have, naming the
+/// line: a duplicate (83 runs were shown for 64), a configuration the sweep does not hold
+/// (h = 77), another mesh (zero hash), a quality_pct of 150 or a quality above the optimum
+/// with as many quads. `report` rewrites summary.csv from the runs it reads.
+#[test]
+fn report_and_merge_refuse_records_no_run_can_have() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = small_sweep(tmp.path(), "d", &["--algo", "optimum", "--no-report"]);
+    let runs = d.join("runs.jsonl");
+    let good = lines_of(&runs);
+    let n = good.len();
+    let optimum_line = good.iter().position(|l| l.contains("\"optimum\"")).unwrap();
+    let tampered: Vec<(&str, Vec<String>, String)> = vec![
+        (
+            "recorded twice (first on line 3)",
+            {
+                let mut l = good.clone();
+                l.push(good[2].clone());
+                l
+            },
+            format!("line {}", n + 1),
+        ),
+        (
+            "not part of this sweep",
+            {
+                let mut l = good.clone();
+                l[1] = edit_line(&l[1], |v| v["horizon"] = 77.into());
+                l
+            },
+            "runs.jsonl:2".into(),
+        ),
+        (
+            "mesh hash",
+            {
+                let mut l = good.clone();
+                l[0] = edit_line(&l[0], |v| v["mesh_hash"] = "0".repeat(64).into());
+                l
+            },
+            "runs.jsonl:1".into(),
+        ),
+        (
+            "quality_pct 150",
+            {
+                let mut l = good.clone();
+                l[3] = edit_line(&l[3], |v| v["quality_pct"] = 150.0.into());
+                l
+            },
+            "line 4".into(),
+        ),
+        (
+            "above the exact optimum",
+            {
+                let mut l = good.clone();
+                let i = optimum_line;
+                l[i] = edit_line(&l[i], |v| {
+                    let q = v["quality"].as_f64().unwrap() * 1.5;
+                    v["quality"] = q.into();
+                    v["quality_pct"] = 150.0.into();
+                });
+                l
+            },
+            format!("line {}", optimum_line + 1),
+        ),
+    ];
+    for (why, lines, at) in tampered {
+        std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
+        for cmd in [
+            &["report", "d", "--no-pictures"][..],
+            &["merge", "d", "--out", "m"],
+        ] {
+            let o = run_in(tmp.path(), cmd);
+            let e = stderr(&o);
+            assert_eq!(o.status.code(), Some(2), "{cmd:?} {why}: {e}");
+            assert!(
+                e.contains(why) && e.contains(&at),
+                "{cmd:?} {why} {at}: {e}"
+            );
+            assert!(!tmp.path().join("m/runs.jsonl").exists());
+        }
+    }
+    std::fs::write(&runs, good.join("\n") + "\n").unwrap();
+    let summary = std::fs::read(d.join("summary.csv")).unwrap();
+    std::fs::write(d.join("summary.csv"), "stale\n").unwrap();
+    let o = run_in(tmp.path(), &["report", "d", "--no-pictures"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(d.join("summary.csv")).unwrap(), summary);
+}
+
+/// Item 6: an optimum cache whose quality was edited (bits included) is not believed: the
+/// sweep recomputes it (greedy was recorded at 166 % of a tampered optimum), and
+/// `--overwrite` never reads the cache.
+#[test]
+fn an_edited_optimum_cache_is_recomputed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let args = |out: &str, extra: &'static str| {
+        let mut a = vec![
+            "sweep",
+            "--mesh",
+            "sphere",
+            "--algo",
+            "greedy",
+            "optimum",
+            "--backend",
+            "cpu",
+            "--out",
+            out,
+            "-q",
+            "--no-report",
+        ];
+        if !extra.is_empty() {
+            a.push(extra);
+        }
+        a.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let run = |a: Vec<String>| {
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        let o = run_in(tmp.path(), &a);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    run(args("d", ""));
+    let optimum = |d: &str| -> f64 {
+        let m: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(tmp.path().join(d).join("manifest.json")).unwrap(),
+        )
+        .unwrap();
+        m["optimum"][0]["quality"].as_f64().unwrap()
+    };
+    let true_opt = optimum("d");
+    let cache_dir = tmp.path().join("d/optimum-cache");
+    let cache = std::fs::read_dir(&cache_dir)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let mut c: serde_json::Value = serde_json::from_slice(&std::fs::read(&cache).unwrap()).unwrap();
+    let fake = true_opt * 0.6;
+    c["optimum"]["quality"] = fake.into();
+    c["quality_bits"] = fake.to_bits().into();
+    let tampered = serde_json::to_vec(&c).unwrap();
+    std::fs::write(&cache, &tampered).unwrap();
+    // A fresh sweep into the same directory (the cache stays) and --overwrite.
+    std::fs::remove_file(tmp.path().join("d/runs.jsonl")).unwrap();
+    run(args("d", ""));
+    assert_eq!(optimum("d"), true_opt);
+    std::fs::write(&cache, &tampered).unwrap();
+    run(args("d", "--overwrite"));
+    assert_eq!(optimum("d"), true_opt);
+    for line in lines_of(&tmp.path().join("d/runs.jsonl")) {
+        let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+        assert!(v["quality_pct"].as_f64().unwrap() <= 100.0, "{line}");
+    }
+}
+
+/// Item 8: sizes that cannot be held are refused before anything is allocated or written,
+/// with the limit (they aborted, exit 134, leaving a manifest and a lock behind).
+#[test]
+fn huge_sizes_are_refused_with_their_limit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (
+            &[
+                "sweep",
+                "--mesh",
+                "sphere",
+                "--horizons",
+                "1..1000000000",
+                "--out",
+                "a",
+            ],
+            "at most 1024",
+        ),
+        (
+            &[
+                "sweep",
+                "--mesh",
+                "sphere",
+                "--algo",
+                "selective",
+                "--runs",
+                "4294967295",
+                "--horizons",
+                "1",
+                "--out",
+                "b",
+            ],
+            "at most 10000000",
+        ),
+        (
+            &[
+                "sweep",
+                "--mesh",
+                "sphere",
+                "--algo",
+                "greedy",
+                "--baseline-runs",
+                "4294967295",
+                "--out",
+                "c",
+            ],
+            "at most 10000000",
+        ),
+        (
+            &[
+                "generate",
+                "grid",
+                "--triangles",
+                "2000000000",
+                "-o",
+                "g.msh",
+            ],
+            "GiB of memory",
+        ),
+    ];
+    for (args, msg) in cases {
+        let o = run_in(tmp.path(), args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(msg), "{args:?}: {}", stderr(&o));
+    }
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// Runs `quadrecomb args` in `dir` under bash with `limits` (ulimit commands); kills it
+/// after `secs` seconds (a hang is a failure, not a stuck test).
+fn run_limited(dir: &Path, limits: &str, args: &[&str], secs: u64) -> Output {
+    let mut child = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!("{limits}; exec \"$0\" \"$@\""))
+        .arg(bin())
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed().as_secs() >= secs {
+            child.kill().unwrap();
+            let _ = child.wait();
+            panic!("{args:?} did not finish in {secs} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Item 10: inputs that never end. A FIFO without a writer (blocked forever), a character
+/// device (`/dev/zero` was read for 8 GB) and a directory are refused as not regular files;
+/// a 2 GB sparse file is called an unknown format from its first bytes, within 1 GB of
+/// address space (it was read whole first).
+#[cfg(unix)]
+#[test]
+fn inputs_that_never_end_are_refused_from_their_first_bytes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut cases: Vec<(String, &str)> = vec![
+        ("/dev/zero".into(), "a character device, not a mesh file"),
+        (".".into(), "a directory, not a mesh file"),
+    ];
+    if mkfifo(&tmp.path().join("fifo.msh")) {
+        cases.push(("fifo.msh".into(), "a FIFO (named pipe), not a mesh file"));
+    }
+    let big = std::fs::File::create(tmp.path().join("big.msh")).unwrap();
+    big.set_len(2 << 30).unwrap();
+    cases.push(("big.msh".into(), "unknown mesh format"));
+    for (input, msg) in &cases {
+        for cmd in ["info", "optimum"] {
+            let o = run_limited(tmp.path(), "ulimit -v 1000000", &[cmd, input], 20);
+            assert_eq!(o.status.code(), Some(2), "{cmd} {input}: {}", stderr(&o));
+            assert!(stderr(&o).contains(msg), "{cmd} {input}: {}", stderr(&o));
+        }
+    }
+}
+
+/// Item 12: mesh names are escaped in report.md (`## Mesh <img src=x onerror=alert(2)>` was
+/// raw HTML there), and meshes whose names slug alike (`a b`, `a-b`) get figures of their
+/// own (both wrote `figures/a-b-*.svg`).
+#[test]
+fn report_escapes_mesh_names_and_keeps_figures_apart() {
+    let tmp = tempfile::tempdir().unwrap();
+    let names = ["a b", "a-b", "<img src=x onerror=alert(2)>"];
+    for (i, n) in names.iter().enumerate() {
+        let file = format!("{n}.msh");
+        let seed = (i + 1).to_string();
+        let args = [
+            "generate",
+            "grid",
+            "--triangles",
+            "60",
+            "--seed",
+            &seed,
+            "-o",
+            &file,
+        ];
+        let o = run_in(tmp.path(), &args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let mut args = vec!["sweep", "--mesh"];
+    let files: Vec<String> = names.iter().map(|n| format!("{n}.msh")).collect();
+    args.extend(files.iter().map(String::as_str));
+    args.extend([
+        "--algo",
+        "selective",
+        "greedy",
+        "--horizons",
+        "1,2",
+        "--runs",
+        "2",
+        "--backend",
+        "cpu",
+        "--out",
+        "d",
+        "-q",
+    ]);
+    let o = run_in(tmp.path(), &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = std::fs::read_to_string(tmp.path().join("d/report.md")).unwrap();
+    let raw = md.match_indices('<').any(|(i, _)| !md[..i].ends_with('\\'));
+    assert!(!raw, "raw HTML in report.md");
+    assert!(
+        md.contains(r"## Mesh \<img src=x onerror=alert(2)\>"),
+        "{md}"
+    );
+    let listed: Vec<String> = lines_of(&tmp.path().join("d/report-files.txt"));
+    // Three box plots and one picture per mesh, none shared.
+    assert_eq!(listed.len(), 3 * 4, "{listed:?}");
+    let unique: std::collections::BTreeSet<_> = listed.iter().collect();
+    assert_eq!(unique.len(), listed.len(), "{listed:?}");
+    for f in &listed {
+        assert!(tmp.path().join("d").join(f).is_file(), "{f}");
+        assert!(md.contains(&format!("]({f})")), "{f} not linked");
+    }
+}
