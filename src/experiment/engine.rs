@@ -128,6 +128,17 @@ pub fn check_records(
             });
         };
         let mesh = &manifest.spec.meshes[job.mesh];
+        if r.rule() != manifest.spec.rule() {
+            return Err(ExperimentError::Mismatch {
+                dir: path.to_path_buf(),
+                message: format!(
+                    "{}:{line}: run {key} was made under the rule {}, this sweep's is {}",
+                    runs.display(),
+                    r.rule(),
+                    manifest.spec.rule()
+                ),
+            });
+        }
         if (seeds && r.seed != job.seed)
             || r.mesh_hash != mesh.hash
             || r.triangles != mesh.triangles
@@ -202,6 +213,27 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             "quality {} is above its {} quads (eta is at most 1 each)",
             r.quality, r.quads
         ));
+    }
+    // The element figures: eta lies in [0, 1], above the rule's threshold (and above 0
+    // unless every pair was allowed), and no more quads are poor than there are.
+    for (name, v) in [("worst_eta", r.worst_eta), ("mean_eta", r.mean_eta)] {
+        let low = if r.allow_invalid { 0.0 } else { r.min_eta };
+        let ok = |v: f64| v.is_finite() && (low..=1.0).contains(&v) && (r.allow_invalid || v > 0.0);
+        if v.is_some_and(|v| !ok(v)) || (v.is_some() && r.quads == 0) {
+            return Err(format!(
+                "{name} {v:?} is not the eta of one of its {} quads under the rule {}",
+                r.quads,
+                r.rule()
+            ));
+        }
+    }
+    for (name, n) in [
+        ("quads_eta_below_0_1", r.quads_eta_below_0_1),
+        ("quads_eta_below_0_3", r.quads_eta_below_0_3),
+    ] {
+        if n.is_some_and(|n| n > r.quads) {
+            return Err(format!("{name} {n:?} is more than its {} quads", r.quads));
+        }
     }
     if let Some(pct) = r.quality_pct {
         if !pct.is_finite() || pct < 0.0 {

@@ -423,6 +423,24 @@ fn report_and_merge_refuse_records_no_run_can_have() {
             },
             format!("line {}", optimum_line + 1),
         ),
+        (
+            "was made under the rule",
+            {
+                let mut l = good.clone();
+                l[0] = edit_line(&l[0], |v| v["allow_invalid"] = true.into());
+                l
+            },
+            "runs.jsonl:1".into(),
+        ),
+        (
+            "worst_eta Some(0.0) is not the eta of one of its",
+            {
+                let mut l = good.clone();
+                l[1] = edit_line(&l[1], |v| v["worst_eta"] = 0.0.into());
+                l
+            },
+            "line 2".into(),
+        ),
     ];
     for (why, lines, at) in tampered {
         std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
