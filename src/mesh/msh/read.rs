@@ -1163,6 +1163,8 @@ fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     let min_bytes = if p.binary { 32 } else { 8 };
     c.node_tags.reserve(cap(total, min_bytes, left));
     c.data.vertices.reserve(cap(total, min_bytes, left));
+    c.model.node_entity.reserve(cap(total, min_bytes, left));
+    c.model.node_param.reserve(cap(total, min_bytes, left));
     for blk in 0..blocks {
         let what_blk = || format!("the header of node block {} of {blocks}", blk + 1);
         let dp = p.pos;
@@ -1343,6 +1345,8 @@ fn parametric_nodes22(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     let min_bytes = if p.binary { 36 } else { 12 };
     c.node_tags.reserve(cap(total, min_bytes, left));
     c.data.vertices.reserve(cap(total, min_bytes, left));
+    c.model.node_entity.reserve(cap(total, min_bytes, left));
+    c.model.node_param.reserve(cap(total, min_bytes, left));
     for i in 0..total {
         let tp = p.pos;
         let tag = p.int_field(s, &|| format!("the tag of node {} of {total}", i + 1))?;
