@@ -414,7 +414,8 @@ fn model_follows_the_spatial_order() {
                 .iter()
                 .enumerate()
                 .map(|(v, &t)| {
-                    let u = model.node_param[v].map(|u| u.map(f64::to_bits));
+                    let u = model.node_param.get(v).copied().flatten();
+                    let u = u.map(|u| u.map(f64::to_bits));
                     (t, (model.node_entity[v], u))
                 })
                 .collect();

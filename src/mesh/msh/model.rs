@@ -61,7 +61,8 @@ pub struct Model {
     /// not say (an MSH 2.2 node that no element uses).
     pub node_entity: Vec<Option<(u8, i32)>>,
     /// The parametric coordinates of each vertex on its entity (one on a curve, two on a
-    /// surface, three in a volume; the rest 0), where the file has them.
+    /// surface, three in a volume; the rest 0), where the file has them; empty when no
+    /// node has any.
     pub node_param: Vec<Option<[f64; 3]>>,
     /// The point and line elements, in file order.
     pub elements: Vec<Element>,

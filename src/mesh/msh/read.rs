@@ -607,6 +607,8 @@ struct ModelParts {
     /// The entity of each node as the file gives it, aligned with `Content::node_tags`
     /// (`None`: not given, MSH 2.2 `$Nodes`).
     node_entity: Vec<Option<(u8, i32)>>,
+    /// The parametric coordinates of each node, up to the last that has some (empty when
+    /// none has: most files).
     node_param: Vec<Option<[f64; 3]>>,
     /// Point and line elements (on the file's entities).
     elements: Vec<Element>,
@@ -620,6 +622,15 @@ struct ModelParts {
 }
 
 impl ModelParts {
+    /// Records the parametric coordinates of the node just added to `node_entity`.
+    #[inline]
+    fn push_param(&mut self, u: Option<[f64; 3]>) {
+        if u.is_some() || !self.node_param.is_empty() {
+            self.node_param.resize(self.node_entity.len() - 1, None);
+            self.node_param.push(u);
+        }
+    }
+
     /// Notes an element of dimension `dim` on entity `tag` in physical group `physical`
     /// (0: none).
     #[inline]
@@ -642,11 +653,11 @@ impl ModelParts {
     fn finish(mut self, data: &MeshData) -> Model {
         if !self.parents.is_empty() {
             let parents = &self.parents;
-            for (on, param) in self.node_entity.iter_mut().zip(&mut self.node_param) {
+            for (v, on) in self.node_entity.iter_mut().enumerate() {
                 if let Some((dim, tag)) = *on {
                     if let Some(&(pd, pt)) = parents.get(&(dim, tag)) {
                         *on = Some((pd, pt));
-                        if pd != dim {
+                        if let (true, Some(param)) = (pd != dim, self.node_param.get_mut(v)) {
                             *param = None;
                         }
                     }
@@ -677,7 +688,9 @@ impl ModelParts {
         }
         let nv = data.vertices.len();
         self.node_entity.resize(nv, None);
-        self.node_param.resize(nv, None);
+        if !self.node_param.is_empty() {
+            self.node_param.resize(nv, None);
+        }
         if self.node_entity.iter().any(Option::is_none) {
             let on = &mut self.node_entity;
             let mut classify = |nodes: &[u32], dim: u8, tag: i32| {
@@ -1163,6 +1176,7 @@ fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     let min_bytes = if p.binary { 32 } else { 8 };
     c.node_tags.reserve(cap(total, min_bytes, left));
     c.data.vertices.reserve(cap(total, min_bytes, left));
+    c.model.node_entity.reserve(cap(total, min_bytes, left));
     for blk in 0..blocks {
         let what_blk = || format!("the header of node block {} of {blocks}", blk + 1);
         let dp = p.pos;
@@ -1243,7 +1257,7 @@ struct NodeBlock41 {
 /// Records the entity and parametric coordinates (`extra` of `params`) of a node.
 fn classify_node(c: &mut Content, b: &NodeBlock41, params: [f64; 3]) {
     c.model.node_entity.push(Some(b.entity));
-    c.model.node_param.push(parametric(b.extra, params));
+    c.model.push_param(parametric(b.extra, params));
 }
 
 /// The first `n` of `u` as a node's parametric coordinates: none if `n` is 0 or one is not
@@ -1343,6 +1357,7 @@ fn parametric_nodes22(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     let min_bytes = if p.binary { 36 } else { 12 };
     c.node_tags.reserve(cap(total, min_bytes, left));
     c.data.vertices.reserve(cap(total, min_bytes, left));
+    c.model.node_entity.reserve(cap(total, min_bytes, left));
     for i in 0..total {
         let tp = p.pos;
         let tag = p.int_field(s, &|| format!("the tag of node {} of {total}", i + 1))?;
@@ -1385,7 +1400,7 @@ fn parametric_nodes22(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
         c.node_tags.push(tag as u64);
         c.data.vertices.push(x);
         c.model.node_entity.push(Some((dim as u8, entity)));
-        c.model.node_param.push(parametric(params, u));
+        c.model.push_param(parametric(params, u));
     }
     Ok(())
 }
