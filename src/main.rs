@@ -6,11 +6,29 @@ mod cli;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    quiet_mesa_device_select();
     match cli::run() {
         Ok(code) => code,
         Err(err) => {
             eprintln!("error: {}", cli::describe(&err));
             ExitCode::from(cli::exit_code(&err))
         }
+    }
+}
+
+/// Mesa's device-selection layer (an implicit Vulkan layer installed with lavapipe) prints
+/// `error: XDG_RUNTIME_DIR is invalid or not set in the environment.` on every instance it
+/// joins when that variable is unset (cron, Slurm, containers, CI), on a run that then
+/// succeeds. The layer only reorders devices, which `gpu::adapters` ranks itself, so it is
+/// disabled in that case through its own switch, `NODEVICE_SELECT=1` (a user's own setting
+/// of either variable is left alone). The crate's one `unsafe`: setting the environment.
+#[allow(unsafe_code)]
+fn quiet_mesa_device_select() {
+    let runtime_dir_ok =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+    if !runtime_dir_ok && std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: first thing in main, before any thread exists (nothing reads the
+        // environment concurrently).
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
     }
 }

@@ -649,3 +649,56 @@ fn bad_candidate_index_is_an_error_not_a_crash() {
     assert!(err.to_string().contains("vertex 3"), "{err}");
     assert_eq!(Vertex::default().hi, [0.0; 4]);
 }
+
+/// A successful run prints no line that begins with "error:", also with `XDG_RUNTIME_DIR`
+/// unset, where Mesa's device-selection layer (installed with lavapipe) printed
+/// `error: XDG_RUNTIME_DIR is invalid or not set in the environment.` for every instance.
+#[test]
+fn no_error_lines_from_mesa_without_xdg_runtime_dir() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "greedy",
+            "--backend",
+            "gpu",
+            "--no-optimum",
+        ][..],
+        &[
+            "sweep",
+            "--mesh",
+            "sphere",
+            "--algo",
+            "greedy",
+            "--runs",
+            "1",
+            "--no-report",
+            "-q",
+            "--out",
+            "s",
+        ],
+    ] {
+        let out = std::process::Command::new(crate::util::bin())
+            .args(args)
+            .current_dir(dir.path())
+            .env_remove("XDG_RUNTIME_DIR")
+            .env_remove("NODEVICE_SELECT")
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        if !out.status.success()
+            && err.contains("no Vulkan adapter")
+            && std::env::var_os("CI").is_none()
+        {
+            eprintln!("SKIPPED: no Vulkan adapter");
+            return;
+        }
+        assert!(out.status.success(), "{args:?}: {err}");
+        assert!(
+            !err.lines().any(|l| l.starts_with("error:")),
+            "{args:?}: {err}"
+        );
+    }
+}
