@@ -160,8 +160,8 @@ impl Rule {
     }
 }
 
-/// Short name of the rule as reports print it: `valid quads (eta > 0)`, `eta >= 0.3`,
-/// `all pairs (paper-literal)`.
+/// The rule in words, as outputs and reports print it: `valid quads (eta > 0)`, `valid
+/// quads, eta >= 0.3`, `all pairs, eta-0 quads included (paper-literal)`.
 impl std::fmt::Display for Rule {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match *self {
