@@ -77,6 +77,14 @@ pub fn eta_table(
     Ok((table, ev.name().to_string()))
 }
 
+/// The horizon of a tree policy; `None` for the greedy ones.
+fn horizon_of(algo: Algo) -> Option<u32> {
+    match algo {
+        Algo::GreedyNocrit | Algo::Greedy => None,
+        _ => Some(algo.horizon()),
+    }
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let name = match args.algo {
         AlgoName::GreedyNocrit => "greedy-nocrit",
@@ -90,12 +98,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         eprintln!("note: --horizon is ignored: {name} looks no further than one action");
     }
     super::check_mesh_output(args.output.as_deref())?;
+    use super::oom::{self, Phase};
+    oom::phase(Phase::Reading);
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
+    oom::mesh_size(mesh.num_triangles());
+    oom::phase(Phase::Candidates);
     let (table, backend) = eta_table(&mesh, args.backend)?;
-    let out = search::run(&mesh, &table, algo, args.seed);
+    oom::phase(Phase::Search);
+    let mut searcher = search::Searcher::new(&mesh, &table);
+    let bar = super::progress_bar::attach(&mut searcher, horizon_of(algo));
+    let out = searcher.run(algo, args.seed);
+    bar.finish_and_clear();
+    drop(searcher);
     let nt = mesh.num_triangles();
     let recombined_pct = 100.0 * (2 * out.quads) as f64 / nt as f64;
+    oom::phase(Phase::Optimum);
     let opt = (!args.no_optimum).then(|| optimum::solve(&mesh, &table));
+    oom::phase(Phase::Writing);
     let quality_pct = opt
         .as_ref()
         .filter(|o| o.quality > 0.0)
@@ -104,10 +123,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let rec = quality::recombined(&mesh, &table, &out.chosen);
         super::write_mesh_output(path, &mesh, &rec)?;
     }
-    let horizon = match algo {
-        Algo::GreedyNocrit | Algo::Greedy => None,
-        _ => Some(algo.horizon()),
-    };
+    let horizon = horizon_of(algo);
     if args.json {
         let mut v = serde_json::json!({
             "mesh": args.mesh,

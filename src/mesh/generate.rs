@@ -1,9 +1,14 @@
 //! Procedural meshes of any size, without Gmsh, for tests and scaling benchmarks: jittered
-//! right-triangle grids on the unit square ([`grid`]) and icospheres ([`icosphere`]).
+//! right-triangle grids on the unit square ([`grid`]), icospheres ([`icosphere`]) and
+//! one-cell-wide corridors: strips, spirals and mazes ([`corridor`]).
 //!
 //! Both are deterministic: a grid depends only on its [`GridSpec`] (the seed drives a ChaCha8
 //! stream, read as raw `u64`s so the result does not change with `rand`'s distributions), on
 //! every platform.
+
+mod corridor;
+
+pub use corridor::{Corridor, corridor, validate_corridor};
 
 use super::{Mesh, MeshData};
 use rand::{Rng, SeedableRng};

@@ -2,6 +2,7 @@
 
 mod gpu;
 mod io;
+mod memory;
 mod meshes;
 mod optimum;
 mod report;
