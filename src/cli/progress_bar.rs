@@ -8,7 +8,7 @@ use quadrecomb::search::{Progress, Searcher};
 
 /// A run estimated to last longer than this gets a warning.
 const WARN_ABOVE_S: f64 = 60.0;
-/// The estimate is made once the run has lasted this long.
+/// Estimates are made once the run has lasted this long.
 const ESTIMATE_AFTER_S: f64 = 1.0;
 /// The bar appears once the run has lasted this long.
 const BAR_AFTER_S: f64 = 2.0;
@@ -85,10 +85,11 @@ pub fn attach(searcher: &mut Searcher<'_>, horizon: Option<u32>) -> ProgressBar 
     let mut warned = false;
     let mut visible = false;
     searcher.set_progress(move |p| {
-        // One estimate, once the run has lasted long enough for it (a warning or none).
-        if !warned && p.elapsed_s >= ESTIMATE_AFTER_S && (p.recombined > 0 || p.nodes > 0) {
-            warned = true;
+        // Estimated at every report once the run has lasted a second (the later trees can
+        // be the larger ones), said once.
+        if !warned && p.elapsed_s >= ESTIMATE_AFTER_S {
             if let Some(w) = cost_warning(p, horizon) {
+                warned = true;
                 shown.suspend(|| eprintln!("{w}"));
             }
         }
