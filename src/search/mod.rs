@@ -178,6 +178,8 @@ impl<'a> LazyState<'a> {
             let mut state = State::new(self.mesh, self.table);
             // Runs never undo an applied action: no undo log, reset by copying.
             state.set_forward(true);
+            // The work counters count the runs' work, not the initial verdicts'.
+            (state.searches, state.searched) = (0, 0);
             self.state = Some(state);
         }
     }
@@ -292,9 +294,9 @@ impl<'a> Searcher<'a> {
         &self.state
     }
 
-    /// Work counters of the criterion since this searcher was built: the checks that needed
-    /// a search, and the triangles those searches visited (summed over runs; take
-    /// differences around a run). Deterministic for a given run, unlike its time.
+    /// Work counters of the criterion in this searcher's runs: the checks that needed a
+    /// search, and the triangles those searches visited (summed over runs, the initial
+    /// verdicts left out; take differences around a run). Deterministic for a given run, unlike its time.
     pub fn criterion_work(&self) -> (u64, u64) {
         self.state
             .state
