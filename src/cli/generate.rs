@@ -152,7 +152,7 @@ fn corridor(
     shape: Corridor,
     a: CorridorArgs,
 ) -> anyhow::Result<(quadrecomb::mesh::Mesh, String, PathBuf)> {
-    generate::validate_corridor(a.triangles).map_err(|e| BadInput(e.to_string()))?;
+    generate::validate_corridor(shape, a.triangles).map_err(|e| BadInput(e.to_string()))?;
     check_output(&a.output)?;
     let what = format!("{}, seed {}", shape.name(), a.seed);
     Ok((

@@ -50,12 +50,12 @@ impl Corridor {
 }
 
 /// Checks a corridor's size: at least 2 triangles, at most [`MAX_GRID_TRIANGLES`].
-pub fn validate_corridor(triangles: usize) -> Result<(), GenerateError> {
-    if triangles < 2 {
-        return Err(GenerateError::TooFewTriangles(triangles));
-    }
-    if triangles > MAX_GRID_TRIANGLES {
-        return Err(GenerateError::TooManyTriangles(triangles));
+pub fn validate_corridor(shape: Corridor, triangles: usize) -> Result<(), GenerateError> {
+    if !(2..=MAX_GRID_TRIANGLES).contains(&triangles) {
+        return Err(GenerateError::CorridorSize {
+            shape: shape.name(),
+            triangles,
+        });
     }
     Ok(())
 }
@@ -66,8 +66,8 @@ pub fn validate_corridor(triangles: usize) -> Result<(), GenerateError> {
 /// # Panics
 /// If [`validate_corridor`] fails.
 pub fn corridor(shape: Corridor, triangles: usize, seed: u64) -> Mesh {
-    if let Err(e) = validate_corridor(triangles) {
-        panic!("invalid {} of {triangles} triangles: {e}", shape.name());
+    if let Err(e) = validate_corridor(shape, triangles) {
+        panic!("{e}");
     }
     let n = shape.cells_for(triangles);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -213,6 +213,18 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn sizes_out_of_range_are_refused_with_the_shape() {
+        let e = validate_corridor(Corridor::Strip, 1).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!("a strip needs between 2 and {MAX_GRID_TRIANGLES} triangles (asked for 1)")
+        );
+        assert!(validate_corridor(Corridor::Maze, MAX_GRID_TRIANGLES + 1).is_err());
+        assert!(validate_corridor(Corridor::Maze, 2).is_ok());
+        assert_eq!(corridor(Corridor::Maze, 2, 0).num_triangles(), 2);
     }
 
     #[test]
