@@ -5,6 +5,10 @@ mod cli;
 
 use std::process::ExitCode;
 
+/// Out of memory is an error with a message and exit code 2, not an abort.
+#[global_allocator]
+static ALLOC: cli::oom::ExitOnOom = cli::oom::ExitOnOom;
+
 fn main() -> ExitCode {
     quiet_mesa_device_select();
     match cli::run() {

@@ -1,9 +1,9 @@
-//! `quadrecomb generate`: procedural meshes of any size (jittered grid, icosphere), written as
-//! MSH 4.1 ASCII.
+//! `quadrecomb generate`: procedural meshes of any size (jittered grid, icosphere, and
+//! one-cell-wide strip, spiral and maze), written as MSH 4.1 ASCII.
 
 use super::BadInput;
 use quadrecomb::mesh::Recombined;
-use quadrecomb::mesh::generate::{self, GridSpec, MAX_SUBDIVISIONS};
+use quadrecomb::mesh::generate::{self, Corridor, GridSpec, MAX_SUBDIVISIONS};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -21,6 +21,26 @@ enum Shape {
     Grid(GridArgs),
     /// A subdivided icosahedron on the unit sphere (20 * 4^s triangles, closed).
     Icosphere(IcosphereArgs),
+    /// A straight strip one cell high (its dual graph is a path).
+    Strip(CorridorArgs),
+    /// A square spiral one cell wide, its turns one cell apart (a path).
+    Spiral(CorridorArgs),
+    /// A random perfect maze of one-cell corridors (its dual graph is a tree).
+    Maze(CorridorArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct CorridorArgs {
+    /// Target number of triangles (two per unit cell; the mesh gets the nearest count at or
+    /// below it that the shape allows).
+    #[arg(long)]
+    triangles: usize,
+    /// Seed of the diagonals (and of the maze).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Output file (.msh, written as MSH 4.1 ASCII).
+    #[arg(short, long)]
+    output: PathBuf,
 }
 
 #[derive(Debug, clap::Args)]
@@ -111,6 +131,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 a.output,
             )
         }
+        Shape::Strip(a) => corridor(Corridor::Strip, a)?,
+        Shape::Spiral(a) => corridor(Corridor::Spiral, a)?,
+        Shape::Maze(a) => corridor(Corridor::Maze, a)?,
     };
     let generated = start.elapsed().as_secs_f64();
     let start = Instant::now();
@@ -153,6 +176,21 @@ fn check_memory(triangles: usize) -> Result<(), BadInput> {
         )));
     }
     Ok(())
+}
+
+/// A corridor mesh, its description and its output, after the checks.
+fn corridor(
+    shape: Corridor,
+    a: CorridorArgs,
+) -> anyhow::Result<(quadrecomb::mesh::Mesh, String, PathBuf)> {
+    generate::validate_corridor(shape, a.triangles).map_err(|e| BadInput(e.to_string()))?;
+    check_output(&a.output)?;
+    let what = format!("{}, seed {}", shape.name(), a.seed);
+    Ok((
+        generate::corridor(shape, a.triangles, a.seed),
+        what,
+        a.output,
+    ))
 }
 
 /// Fails early (before generating) if the output cannot be a new .msh file.

@@ -94,6 +94,8 @@ fn eta_stats(eta: &[f64]) -> Option<EtaStats> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    use super::oom::{self, Phase};
+    oom::phase(Phase::Reading);
     let t = Instant::now();
     let src = mesh::source(&args.mesh)?;
     let read = ms(t);
@@ -142,9 +144,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         };
         return print(&info, args.json);
     }
+    oom::phase(Phase::Mesh);
+    oom::mesh_size(file.data.triangles.len());
     let t = Instant::now();
     let m = file.into_mesh(&src.path)?;
     let topology = ms(t);
+    oom::phase(Phase::Candidates);
     let t = Instant::now();
     let table = CandidateTable::build(&m);
     let candidates = ms(t);

@@ -4,7 +4,9 @@ mod bench;
 mod generate;
 mod info;
 mod merge;
+pub mod oom;
 mod optimum;
+mod progress_bar;
 mod recombine;
 mod report;
 mod sweep;
@@ -26,7 +28,7 @@ struct Cli {
 enum Command {
     /// Print a mesh's size, topology and candidate quad qualities.
     Info(info::Args),
-    /// Generate a procedural mesh (jittered grid, icosphere) of any size.
+    /// Generate a procedural mesh (jittered grid, icosphere, strip, spiral, maze) of any size.
     Generate(generate::Args),
     /// Recombine a mesh's triangles into quads with one policy.
     Recombine(recombine::Args),

@@ -86,6 +86,14 @@ pub fn eta_table(
     Ok((table.restrict(mesh, rule), ev.name().to_string()))
 }
 
+/// The horizon of a tree policy; `None` for the greedy ones.
+fn horizon_of(algo: Algo) -> Option<u32> {
+    match algo {
+        Algo::GreedyNocrit | Algo::Greedy => None,
+        _ => Some(algo.horizon()),
+    }
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let name = match args.algo {
         AlgoName::GreedyNocrit => "greedy-nocrit",
@@ -101,13 +109,24 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     super::check_mesh_output(args.output.as_deref())?;
     let rule = args.rule.rule()?;
     super::check_not_input(args.output.as_deref(), &args.mesh)?;
+    use super::oom::{self, Phase};
+    oom::phase(Phase::Reading);
     let mesh = quadrecomb::mesh::load(&args.mesh)?;
+    oom::mesh_size(mesh.num_triangles());
+    oom::phase(Phase::Candidates);
     let (table, backend) = eta_table(&mesh, args.backend, rule)?;
-    let out = search::run(&mesh, &table, algo, args.seed);
+    oom::phase(Phase::Search);
+    let mut searcher = search::Searcher::new(&mesh, &table);
+    let bar = super::progress_bar::attach(&mut searcher, horizon_of(algo));
+    let out = searcher.run(algo, args.seed);
+    bar.finish_and_clear();
+    drop(searcher);
     let elements = ElementQuality::of_chosen(&table, &out.chosen);
     let nt = mesh.num_triangles();
     let recombined_pct = 100.0 * (2 * out.quads) as f64 / nt as f64;
+    oom::phase(Phase::Optimum);
     let opt = (!args.no_optimum).then(|| optimum::solve(&mesh, &table));
+    oom::phase(Phase::Writing);
     let quality_pct = opt
         .as_ref()
         .filter(|o| o.quality > 0.0)
@@ -116,10 +135,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let rec = quality::recombined(&mesh, &table, &out.chosen);
         super::write_mesh_output(path, &mesh, &rec)?;
     }
-    let horizon = match algo {
-        Algo::GreedyNocrit | Algo::Greedy => None,
-        _ => Some(algo.horizon()),
-    };
+    let horizon = horizon_of(algo);
     if args.json {
         let mut v = serde_json::json!({
             "mesh": args.mesh,

@@ -1,9 +1,14 @@
 //! Procedural meshes of any size, without Gmsh, for tests and scaling benchmarks: jittered
-//! right-triangle grids on the unit square ([`grid`]) and icospheres ([`icosphere`]).
+//! right-triangle grids on the unit square ([`grid`]), icospheres ([`icosphere`]) and
+//! one-cell-wide corridors: strips, spirals and mazes ([`corridor()`]).
 //!
 //! Both are deterministic: a grid depends only on its [`GridSpec`] (the seed drives a ChaCha8
 //! stream, read as raw `u64`s so the result does not change with `rand`'s distributions), on
 //! every platform.
+
+mod corridor;
+
+pub use corridor::{Corridor, corridor, validate_corridor};
 
 use super::{Mesh, MeshData};
 use rand::{Rng, SeedableRng};
@@ -78,6 +83,11 @@ pub enum GenerateError {
     TooManyDrops { asked: usize, available: usize },
     #[error("icosphere subdivisions must be at most {MAX_SUBDIVISIONS} (got {0})")]
     Subdivisions(u32),
+    #[error("a {shape} needs between 2 and {MAX_GRID_TRIANGLES} triangles (asked for {triangles})")]
+    CorridorSize {
+        shape: &'static str,
+        triangles: usize,
+    },
 }
 
 impl GridSpec {

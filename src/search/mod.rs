@@ -139,11 +139,75 @@ pub struct RunOutcome {
     pub time_s: f64,
 }
 
-/// A reusable searcher for one mesh: the state (with every verdict) is built once and reset
-/// by undoing, so repeated runs in one thread allocate nothing new.
+/// Where a run stands, as its progress callback ([`Searcher::set_progress`]) sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Triangles of the mesh.
+    pub triangles: usize,
+    /// Triangles recombined so far (twice the quads).
+    pub recombined: usize,
+    /// Look-ahead trees built and tree nodes expanded so far.
+    pub trees: u64,
+    pub nodes: u64,
+    /// Seconds since the run started.
+    pub elapsed_s: f64,
+}
+
+/// A run's progress callback (the library prints nothing itself).
+pub struct ProgressFn(Box<dyn FnMut(&Progress) + Send>);
+
+impl fmt::Debug for ProgressFn {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("ProgressFn")
+    }
+}
+
+/// The search state, built on first use: greedy without the criterion needs none (and
+/// should not pay for every verdict in time and memory).
+#[derive(Debug)]
+struct LazyState<'a> {
+    mesh: &'a Mesh,
+    table: &'a CandidateTable,
+    state: Option<State<'a>>,
+}
+
+impl<'a> LazyState<'a> {
+    /// Builds the state (every initial verdict) unless it is built.
+    fn ensure(&mut self) {
+        if self.state.is_none() {
+            let mut state = State::new(self.mesh, self.table);
+            // Runs never undo an applied action: no undo log, reset by copying.
+            state.set_forward(true);
+            // The work counters count the runs' work, not the initial verdicts'.
+            (state.searches, state.searched) = (0, 0);
+            self.state = Some(state);
+        }
+    }
+}
+
+impl<'a> std::ops::Deref for LazyState<'a> {
+    type Target = State<'a>;
+    fn deref(&self) -> &State<'a> {
+        self.state
+            .as_ref()
+            .expect("the state is built before it is used")
+    }
+}
+
+impl std::ops::DerefMut for LazyState<'_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        self.state
+            .as_mut()
+            .expect("the state is built before it is used")
+    }
+}
+
+/// A reusable searcher for one mesh: the state (with every verdict) is built once, on the
+/// first run that needs it, and reset by copying, so repeated runs in one thread allocate
+/// nothing new.
 #[derive(Debug)]
 pub struct Searcher<'a> {
-    state: State<'a>,
+    state: LazyState<'a>,
     /// Candidates by decreasing eta, ties by increasing index.
     order: Vec<u32>,
     /// Position of each candidate in `order`.
@@ -163,9 +227,32 @@ pub struct Searcher<'a> {
     /// Position in `order` up to which `allowed_ranks` is built.
     allowed_scan: usize,
     extra: Vec<Vec<u32>>,
+    /// Called after each decision of the tree policies, every 2^16 tree nodes and every
+    /// 4,096 greedy steps.
+    progress: Option<ProgressFn>,
+    started: Instant,
 }
 
 impl<'a> Searcher<'a> {
+    /// Calls `f` with the run's progress as it goes (see [`Progress`]); replaces any
+    /// callback set before.
+    pub fn set_progress(&mut self, f: impl FnMut(&Progress) + Send + 'static) {
+        self.progress = Some(ProgressFn(Box::new(f)));
+    }
+
+    /// Reports progress to the callback, if any. `quads`: quads made so far.
+    pub(crate) fn tick(&mut self, quads: usize) {
+        if let Some(ProgressFn(f)) = &mut self.progress {
+            f(&Progress {
+                triangles: self.state.mesh.num_triangles(),
+                recombined: 2 * quads,
+                trees: self.trees,
+                nodes: self.nodes,
+                elapsed_s: self.started.elapsed().as_secs_f64(),
+            });
+        }
+    }
+
     /// Builds the state and the eta order for `mesh` and `table`.
     pub fn new(mesh: &'a Mesh, table: &'a CandidateTable) -> Searcher<'a> {
         let mut order: Vec<u32> = (0..table.len() as u32).collect();
@@ -178,11 +265,12 @@ impl<'a> Searcher<'a> {
         for (i, &c) in order.iter().enumerate() {
             rank[c as usize] = i as u32;
         }
-        let mut state = State::new(mesh, table);
-        // Runs never undo an applied action: no undo log, reset by copying.
-        state.set_forward(true);
         Searcher {
-            state,
+            state: LazyState {
+                mesh,
+                table,
+                state: None,
+            },
             order,
             rank,
             revisit: std::collections::BinaryHeap::new(),
@@ -195,30 +283,40 @@ impl<'a> Searcher<'a> {
             allowed_scan: 0,
             extra: Vec::new(),
             used: vec![false; mesh.num_triangles()],
+            progress: None,
+            started: Instant::now(),
         }
     }
 
-    /// The state (at its initial position between runs).
-    pub fn state(&self) -> &State<'a> {
+    /// The state (at its initial position between runs), built if no run built it yet.
+    pub fn state(&mut self) -> &State<'a> {
+        self.state.ensure();
         &self.state
     }
 
-    /// Work counters of the criterion since this searcher was built: the checks that needed
-    /// a search, and the triangles those searches visited (summed over runs; take
-    /// differences around a run). Deterministic for a given run, unlike its time.
+    /// Work counters of the criterion in this searcher's runs: the checks that needed a
+    /// search, and the triangles those searches visited (summed over runs, the initial
+    /// verdicts left out; take differences around a run). Deterministic for a given run, unlike its time.
     pub fn criterion_work(&self) -> (u64, u64) {
-        (self.state.searches, self.state.searched)
+        self.state
+            .state
+            .as_ref()
+            .map_or((0, 0), |s| (s.searches, s.searched))
     }
 
     /// Runs `algo` with `seed` from the initial mesh. The same seed gives the same run on
     /// every platform (ChaCha8).
     pub fn run(&mut self, algo: Algo, seed: u64) -> RunOutcome {
-        self.state.reset();
+        if algo != Algo::GreedyNocrit {
+            self.state.ensure();
+            self.state.reset();
+        }
         self.cursor = 0;
         self.nodes = 0;
         self.trees = 0;
         self.rng = ChaCha8Rng::seed_from_u64(seed);
         let start = Instant::now();
+        self.started = start;
         let chosen = match algo {
             Algo::GreedyNocrit => self.greedy_nocrit(),
             Algo::Greedy => {
@@ -235,7 +333,7 @@ impl<'a> Searcher<'a> {
             }
         };
         let time_s = start.elapsed().as_secs_f64();
-        let table = self.state.table();
+        let table = self.state.table;
         let quality = table.quality_of(&chosen);
         let quads = chosen.len();
         let trees = match algo {
@@ -244,7 +342,7 @@ impl<'a> Searcher<'a> {
         };
         let out = RunOutcome {
             quads,
-            triangles_left: self.state.mesh().num_triangles() - 2 * quads,
+            triangles_left: self.state.mesh.num_triangles() - 2 * quads,
             quality,
             nodes_expanded: if matches!(algo, Algo::GreedyNocrit | Algo::Greedy) {
                 quads as u64
@@ -256,7 +354,9 @@ impl<'a> Searcher<'a> {
             time_s,
             chosen,
         };
-        self.state.reset();
+        if let Some(state) = &mut self.state.state {
+            state.reset();
+        }
         out
     }
 }

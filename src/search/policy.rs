@@ -77,7 +77,7 @@ impl Searcher<'_> {
 
     /// Decreasing eta, no criterion.
     pub(super) fn greedy_nocrit(&mut self) -> Vec<u32> {
-        let table = self.state.table();
+        let table = self.state.table;
         self.used.iter_mut().for_each(|u| *u = false);
         let mut chosen = Vec::new();
         for &c in &self.order {
@@ -124,6 +124,10 @@ impl Searcher<'_> {
                 break;
             }
             self.state.apply_lazy(next);
+            let quads = self.state.quads();
+            if quads % 4096 == 0 {
+                self.tick(quads);
+            }
             let fresh = self.state.dirty_since(seen);
             seen += fresh.len();
             for &c in fresh {
@@ -161,6 +165,8 @@ impl Searcher<'_> {
                 break;
             }
             self.state.apply(first);
+            let quads = self.state.quads();
+            self.tick(quads);
         }
     }
 
@@ -254,6 +260,10 @@ impl Searcher<'_> {
             if !expanded {
                 expanded = true;
                 self.nodes += 1;
+                if self.nodes & 0xFFFF == 0 {
+                    let quads = self.state.quads();
+                    self.tick(quads);
+                }
             }
             let r = if d == 0 { c } else { root };
             if d + 1 == h {
@@ -296,6 +306,8 @@ impl Searcher<'_> {
             }
             self.nodes += 1;
             self.trees += 1;
+            let quads = self.state.quads();
+            self.tick(quads);
             self.state.tree_begin();
             let key = self.rng.next_u64();
             // Children in decreasing reward, so good leaves come first and bound the rest;
@@ -356,6 +368,10 @@ impl Searcher<'_> {
             return 0.0;
         };
         self.nodes += 1;
+        if self.nodes & 0xFFFF == 0 {
+            let quads = self.state.quads();
+            self.tick(quads);
+        }
         let mut kids = [(-1.0, NONE); 3];
         for (i, c) in self.state.candidates_of(t).into_iter().enumerate() {
             if allowed & (1 << i) != 0 {

@@ -3,6 +3,7 @@
 mod files;
 mod gpu;
 mod io;
+mod memory;
 mod meshes;
 mod model;
 mod optimum;

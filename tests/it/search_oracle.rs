@@ -15,7 +15,8 @@ mod walk;
 
 use meshes::{Diagonals, Grid, Surfaces};
 use naive::Naive;
-use quadrecomb::mesh::{Mesh, NONE};
+use quadrecomb::mesh::generate::{self, Corridor};
+use quadrecomb::mesh::{Mesh, MeshData, NONE};
 use quadrecomb::quality::CandidateTable;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -497,6 +498,26 @@ fn sample_meshes(seed: u64) -> Vec<(String, Mesh)> {
         }
     }
     out.push(("icosphere(1)".into(), meshes::icosphere(1)));
+    // Long thin polders (one-cell corridors): splits with parts over LONG_PART triangles,
+    // whose certificates list only their seeds; one odd (a triangle short).
+    for (shape, n) in [
+        (Corridor::Strip, 150),
+        (Corridor::Spiral, 160),
+        (Corridor::Maze, 220),
+    ] {
+        let name = format!("corridor({shape:?}, {n}, seed {seed})");
+        out.push((name, generate::corridor(shape, n, seed)));
+    }
+    let spiral = generate::corridor(Corridor::Spiral, 162, seed);
+    let odd = MeshData {
+        vertices: spiral.vertices.clone(),
+        triangles: spiral.triangles[..spiral.triangles.len() - 1].to_vec(),
+        ..MeshData::default()
+    };
+    out.push((
+        format!("corridor(Spiral, 162, seed {seed}) less its last triangle"),
+        Mesh::new(odd).unwrap(),
+    ));
     for (k, (points, flips, drop, surfaces)) in
         [(90, 120, 0.0, 1), (100, 120, 0.06, 1), (120, 100, 0.02, 2)]
             .into_iter()

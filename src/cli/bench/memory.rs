@@ -30,7 +30,7 @@ pub struct Args {
 /// the memory cannot be had.
 fn random_cycle(n: usize, rng: &mut ChaCha8Rng) -> Option<Vec<u64>> {
     let mut order: Vec<u64> = Vec::new();
-    order.try_reserve_exact(n).ok()?;
+    crate::cli::oom::fallible(|| order.try_reserve_exact(n)).ok()?;
     order.extend(0..n as u64);
     for i in (1..n).rev() {
         let j = rng.random_range(0..i);

@@ -4,6 +4,7 @@ mod gpu;
 mod io;
 mod memory;
 mod optimum;
+mod rss;
 mod search;
 
 use std::process::ExitCode;
@@ -26,6 +27,9 @@ enum What {
     Gpu(gpu::Args),
     /// This machine's random-access latency by working-set size (what large meshes cost).
     Memory(memory::Args),
+    /// Peak resident memory of `recombine` per triangle on generated shapes (grid, strip,
+    /// spiral, maze), each run a child process.
+    Rss(rss::Args),
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -35,5 +39,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         What::Optimum(a) => optimum::run(a),
         What::Gpu(a) => gpu::run(a),
         What::Memory(a) => memory::run(a),
+        What::Rss(a) => rss::run(a),
     }
 }

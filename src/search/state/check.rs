@@ -27,7 +27,8 @@ const LOCAL_OK: [bool; 256] = {
 };
 
 use super::{
-    BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT, Op, State, Verdict,
+    BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT, KIND_SPLIT_LONG,
+    LONG_PART, Op, State, Verdict,
 };
 use crate::mesh::NONE;
 
@@ -239,21 +240,31 @@ impl State<'_> {
                 }
                 // Certificate: the finished parts whole; for the running part, the paths
                 // along which its searches met, or only its seeds when it is one search
-                // (every triangle of that part then hangs off those seeds).
+                // (every triangle of that part then hangs off those seeds). A finished part
+                // of more than LONG_PART triangles found by one search is certified by its
+                // seeds too (KIND_SPLIT_LONG): while they remain (and its clean vertices
+                // stay clean) it stays one part, hanging off them, and an action inside it
+                // changes its parity only by cutting off pieces of odd total, which
+                // changes the parity of the polder as well; so the verdict holds while no
+                // split changes the polder's parity.
+                let mut long = false;
                 for s in 0..ns {
                     let g = self.group[s] as usize;
                     let alone = (0..ns).filter(|&r| self.group[r] as usize == g).count() == 1;
-                    self.cert_len[s] = if !gdone[g] && alone {
+                    let seeds = alone && (!gdone[g] || self.queue[s].len() > LONG_PART);
+                    long |= seeds && gdone[g];
+                    self.cert_len[s] = if seeds {
                         self.nseed[s]
                     } else {
                         self.queue[s].len()
                     };
                     self.finished[s] = gdone[g];
                 }
+                let kind = if long { KIND_SPLIT_LONG } else { KIND_SPLIT };
                 return Verdict {
                     fin_odd: odd as u8,
                     fin_known: known,
-                    ..verdict(all <= 1, KIND_SPLIT)
+                    ..verdict(all <= 1, kind)
                 };
             }
         }
@@ -309,9 +320,17 @@ impl State<'_> {
     /// (never undoing past it); `Some(allowed)` if so, `None` if it must be recomputed. The
     /// vertices that were clean must still be, its certificate (in `arena`) intact; a split's
     /// verdict is re-derived from the current size of the polder (the running part is the
-    /// rest of it).
+    /// rest of it); a long split's holds while its polder is not among `changed` (the
+    /// polders whose parity a split changed since the verdict was computed, with every
+    /// part later cut from them).
     #[inline]
-    pub(super) fn still_holds(&self, c: u32, v: &Verdict, arena: &[u32]) -> Option<bool> {
+    pub(super) fn still_holds(
+        &self,
+        c: u32,
+        v: &Verdict,
+        arena: &[u32],
+        changed: &[u32],
+    ) -> Option<bool> {
         if v.mask != 0 {
             let q = self.cand[c as usize].quad;
             for i in 0..4 {
@@ -337,6 +356,10 @@ impl State<'_> {
             return Some(true);
         }
         let t0 = self.cand[c as usize].pair[0];
+        if v.kind == KIND_SPLIT_LONG {
+            let p = self.polder[t0 as usize];
+            return (!changed.contains(&p)).then_some(v.allowed);
+        }
         let total = self.polder_size[self.polder[t0 as usize] as usize] - 2;
         let rest = total.wrapping_sub(v.fin_known);
         Some(v.fin_odd as u32 + (rest & 1) <= 1)

@@ -44,6 +44,7 @@
 
 #![allow(clippy::needless_range_loop)] // index loops over the 4 quad sides read best
 
+mod acyclic;
 mod check;
 mod pk;
 mod tree;
@@ -63,6 +64,22 @@ const KIND_SPLIT: u8 = 2;
 /// The quad touches removed regions in several places, all in distinct dead components:
 /// one part. Depends on those components staying distinct.
 const KIND_DISTINCT: u8 = 3;
+/// A split with a finished part too large to list (over [`LONG_PART`] triangles, found by
+/// one search): that part is certified by its seeds only, like the running part. Depends
+/// on the listed triangles and on no split on its polder changing the polder's parity
+/// (the verdict is not re-derived from the polder's size).
+const KIND_SPLIT_LONG: u8 = 4;
+/// Largest finished part a split verdict's certificate lists triangle by triangle. A part
+/// found by one search needs only its seeds (see [`KIND_SPLIT_LONG`]): on a long thin
+/// polder (a one-cell strip) listing every part made the certificates quadratic in the
+/// strip's length.
+const LONG_PART: usize = 32;
+
+/// A split verdict, listed (`KIND_SPLIT`) or long (`KIND_SPLIT_LONG`).
+#[inline]
+fn is_split(kind: u8) -> bool {
+    kind == KIND_SPLIT || kind == KIND_SPLIT_LONG
+}
 /// Per candidate, on one cache line (64 bytes, aligned): what the local proof reads, its
 /// pair, its verdict, the verdict's version and stale mark, which are read together.
 #[derive(Debug, Clone, Copy)]
@@ -207,6 +224,9 @@ pub struct State<'a> {
     /// when the state is reset).
     base_cert: Vec<u32>,
     base_cert_init: usize,
+    /// Forward mode: arena length from which [`State::compact_base_cert`] drops the
+    /// certificates of verdicts since recomputed.
+    base_cert_compact_at: usize,
     ver: u32,
     dead_count: Vec<u32>,
     polder: Vec<u32>,
@@ -418,6 +438,7 @@ impl<'a> State<'a> {
             sets: OrderedSets::new(nt),
             base_cert: Vec::new(),
             base_cert_init: 0,
+            base_cert_compact_at: 0,
             ver: 0,
             dead_count: vec![0; nv],
             polder,
@@ -469,12 +490,22 @@ impl<'a> State<'a> {
                 st.union(q[0], q[i]);
             }
         }
+        // Components without a cycle (corridors) all at once; a search per candidate
+        // elsewhere.
+        let acyclic = st.acyclic_parts();
         for c in 0..m as u32 {
-            st.recheck_one(c);
+            match acyclic.as_ref().and_then(|a| st.acyclic_verdict(a, c)) {
+                Some(r) => st.install_verdict(c, r),
+                None => st.recheck_one(c),
+            }
         }
-        // The initial verdicts are the base state: nothing to undo before it.
-        st.log.clear();
+        drop(acyclic);
+        // The initial verdicts are the base state: nothing to undo before it (and the log's
+        // memory, as large as every initial change, is given back).
+        st.log = Vec::new();
         st.base_cert_init = st.base_cert.len();
+        st.base_cert.shrink_to_fit();
+        st.base_cert_compact_at = st.base_cert_init + m.max(1024);
         st
     }
 
@@ -612,10 +643,19 @@ impl<'a> State<'a> {
 
     /// Recomputes the verdict of live candidate `c` and records its certificate.
     fn recheck_one(&mut self, c: u32) {
+        if self.forward && self.base_cert.len() >= self.base_cert_compact_at {
+            self.compact_base_cert();
+        }
         if self.shrink_split(c) {
             return;
         }
-        let mut r = self.check(c);
+        let r = self.check(c);
+        self.install_verdict(c, r);
+    }
+
+    /// Makes `r` the verdict of `c`, its certificate the one the last check left in scratch
+    /// ([`State::append_cert`]), and updates the counts, watch lists and split list.
+    fn install_verdict(&mut self, c: u32, mut r: Verdict) {
         let ci = c as usize;
         let old = self.cand[ci].verdict;
         // A verdict of the local kind is never read back through its mask (the trees
@@ -655,11 +695,11 @@ impl<'a> State<'a> {
             }
         }
         let in_split = self.split_pos[ci] != NONE;
-        if r.kind == KIND_SPLIT && !in_split {
+        if is_split(r.kind) && !in_split {
             self.split_pos[ci] = self.split.len() as u32;
             self.split.push(c);
             self.base_log(Op::SplitIns);
-        } else if r.kind != KIND_SPLIT && in_split {
+        } else if !is_split(r.kind) && in_split {
             let p = self.split_pos[ci];
             self.split.swap_remove(p as usize);
             if let Some(&y) = self.split.get(p as usize) {
@@ -791,6 +831,37 @@ impl<'a> State<'a> {
             }
         }
         true
+    }
+
+    /// Forward mode: the certificate arena keeps only what the current verdicts of live
+    /// candidates refer to (past the initial verdicts', which a reset brings back). Runs
+    /// append a certificate per recomputed verdict; without this the arena grew with every
+    /// recheck of a run (1.6 GB for greedy on a 10^6-triangle grid). Called when the arena
+    /// has grown by the candidate count and twice what was kept, so the copying costs O(1)
+    /// per appended entry.
+    fn compact_base_cert(&mut self) {
+        debug_assert!(self.forward, "undo logs refer to arena offsets");
+        let init = self.base_cert_init;
+        let mut kept: Vec<u32> = Vec::new();
+        for c in 0..self.cand.len() {
+            let v = self.cand[c].verdict;
+            if (v.cert as usize) < init || v.cert_len == 0 {
+                continue;
+            }
+            let [a, b] = self.cand[c].pair;
+            let v = &mut self.cand[c].verdict;
+            if !self.alive[a as usize] || !self.alive[b as usize] {
+                // Never read again before a reset restores the initial verdicts.
+                (v.cert, v.cert_len) = (0, 0);
+                continue;
+            }
+            let (off, len) = (v.cert as usize, v.cert_len as usize);
+            v.cert = (init + kept.len()) as u32;
+            kept.extend_from_slice(&self.base_cert[off..off + len]);
+        }
+        self.base_cert.truncate(init);
+        self.base_cert.extend_from_slice(&kept);
+        self.base_cert_compact_at = init + (2 * kept.len()).max(self.cand.len()).max(1024);
     }
 
     /// Logs a change of the base state for `undo`; forward mode undoes nothing and keeps
@@ -941,12 +1012,12 @@ impl<'a> State<'a> {
         // parts are relabelled).
         let v = self.cand[ci].verdict;
         let exact_before = self.dirty_list.is_empty();
-        let r = if !self.cand[ci].dirty && v.allowed && v.kind != KIND_SPLIT {
+        let r = if !self.cand[ci].dirty && v.allowed && !is_split(v.kind) {
             v
         } else {
             self.check(c)
         };
-        let split = r.kind == KIND_SPLIT;
+        let split = is_split(r.kind);
         self.last_local = if exact_before && r.kind == KIND_LOCAL {
             c
         } else {

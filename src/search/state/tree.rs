@@ -23,7 +23,7 @@
 //! the base split verdicts (their polder's parity may differ).
 
 use super::check::LOCAL_PROOF;
-use super::{DEAD, KIND_LOCAL, KIND_SPLIT, Op, State, Verdict};
+use super::{DEAD, KIND_LOCAL, Op, State, Verdict, is_split};
 use crate::mesh::NONE;
 
 /// A triangle next to the path's quads, as [`State::tree_near`] lists it.
@@ -66,8 +66,15 @@ pub(super) struct Overlay {
     /// triangle around it (restored on pop from `touched_log`).
     touched_at: Vec<u32>,
     touched_log: Vec<u32>,
-    /// Certificates of the tree's verdicts (cleared at each `tree_begin`).
+    /// Certificates of the tree's verdicts (cleared at each `tree_begin`, and cut back on
+    /// each pop to its length at the push: the popped nodes' verdicts are never read again,
+    /// so a tree holds certificates for its current path only, however many nodes it
+    /// explores).
     pub(super) cert: Vec<u32>,
+    cert_len: Vec<usize>,
+    /// Sizes for the per-element arrays, allocated at the first `tree_begin` (greedy builds
+    /// no tree and needs none of them).
+    sizes: (usize, usize, usize),
     /// Actions pushed, and the serial number of the node at each depth (0: the root).
     path: Vec<u32>,
     serial: Vec<u32>,
@@ -94,11 +101,13 @@ impl Overlay {
             slots: Vec::new(),
             slots_end: vec![0],
             slots_serial: Vec::new(),
-            touched_at: vec![0; nv],
+            touched_at: Vec::new(),
             touched_log: Vec::new(),
-            cached: vec![Cached::default(); m],
+            cached: Vec::new(),
             shadowed: Vec::new(),
             cert: Vec::new(),
+            cert_len: Vec::new(),
+            sizes: (m, nv, nt),
             path: Vec::new(),
             serial: Vec::new(),
             next_serial: 0,
@@ -106,7 +115,7 @@ impl Overlay {
             changed_len: Vec::new(),
             affected_cands: Vec::new(),
             affected: Vec::new(),
-            affected_mark: vec![0; nt],
+            affected_mark: Vec::new(),
             affected_epoch: 0,
             new_count: Vec::new(),
             removed: Vec::new(),
@@ -128,6 +137,12 @@ impl State<'_> {
         assert!(self.tree.is_empty(), "tree_begin with actions pushed");
         self.resolve_all();
         let tr = &mut self.tree;
+        if tr.cached.is_empty() {
+            let (m, nv, nt) = tr.sizes;
+            tr.cached = vec![Cached::default(); m];
+            tr.touched_at = vec![0; nv];
+            tr.affected_mark = vec![0; nt];
+        }
         if tr.next_serial >= u32::MAX - (1 << 20) {
             // Serial numbers are about to wrap: forget every cached verdict.
             tr.cached.iter_mut().for_each(|e| e.serial = 0);
@@ -297,13 +312,16 @@ impl State<'_> {
         let ancestor = od <= d && tr.serial[od] == e.serial;
         if ancestor {
             let v = e.verdict;
-            if let Some(a) = self.still_holds(c, &v, &tr.cert) {
+            // Parity changes on the path below the node the verdict was computed at.
+            let since = tr.changed_len.get(od).map_or(tr.changed.len(), |&n| n);
+            if let Some(a) = self.still_holds(c, &v, &tr.cert, &tr.changed[since..]) {
                 return (a, v.kind);
             }
         }
         let v = self.cand[ci].verdict;
         if v.kind != KIND_LOCAL {
-            if let Some(a) = self.still_holds(c, &v, &self.base_cert) {
+            let tr = &self.tree;
+            if let Some(a) = self.still_holds(c, &v, &self.base_cert, &tr.changed) {
                 return (a, v.kind);
             }
         }
@@ -331,13 +349,13 @@ impl State<'_> {
         let ci = c as usize;
         let [t0, t1] = self.cand[ci].pair;
         // Only a split changes more than the polder's size.
-        let split = self.tree_verdict(c).1 == KIND_SPLIT;
+        let split = is_split(self.tree_verdict(c).1);
         self.log.push(Op::TreeApply(c));
         self.tree.changed_len.push(self.tree.changed.len());
         if split {
             // The parts are needed to relabel them: search again (the smaller parts).
             let again = self.check(c);
-            debug_assert_eq!(again.kind, KIND_SPLIT);
+            debug_assert!(is_split(again.kind));
             // Parities are relative to the root: a part of a polder whose parity already
             // changed on the path has changed too, whatever this split does.
             let p = self.polder[t0 as usize];
@@ -370,6 +388,7 @@ impl State<'_> {
         }
         let tr = &mut self.tree;
         tr.next_serial += 1;
+        tr.cert_len.push(tr.cert.len());
         tr.path.push(c);
         tr.serial.push(tr.next_serial);
         for v in q {
@@ -394,6 +413,8 @@ impl State<'_> {
         let c = tr.path.pop().expect("a pushed action");
         let n = tr.changed_len.pop().expect("logged");
         tr.changed.truncate(n);
+        let n = tr.cert_len.pop().expect("logged");
+        tr.cert.truncate(n);
         for v in self.cand[c as usize].quad.into_iter().rev() {
             tr.touched_at[v as usize] = tr.touched_log.pop().expect("logged");
         }
@@ -555,5 +576,69 @@ impl State<'_> {
             }
         }
         tr.affected_cands = cands;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::{GridSpec, grid};
+    use crate::quality::CandidateTable;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// A tree keeps certificates for its current path only: after any number of nodes
+    /// explored below the root, popping back leaves the arena as the root had it. (It kept
+    /// every node's until the next tree: selective h = 100 grew without end.)
+    #[test]
+    fn tree_certificates_are_bounded_by_the_path() {
+        let m = grid(GridSpec {
+            triangles: 600,
+            holes: true,
+            drop_triangles: 3,
+            seed: 11,
+            ..GridSpec::default()
+        });
+        let table = CandidateTable::build(&m);
+        let mut st = State::new(&m, &table);
+        st.set_forward(true);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let nc = table.len() as u64;
+        for _decision in 0..5 {
+            st.tree_begin();
+            let mut grew = false;
+            for _excursion in 0..300 {
+                let mut at_root = None;
+                for _depth in 0..8 {
+                    // Ask for verdicts (some recomputed, with certificates), then go down.
+                    for _ in 0..20 {
+                        let c = (rng.next_u64() % nc) as u32;
+                        if st.is_live(c) {
+                            st.tree_allowed(c);
+                        }
+                    }
+                    let live: Vec<u32> = (0..nc as u32)
+                        .filter(|&c| st.is_live(c) && st.tree_allowed(c))
+                        .collect();
+                    let here = st.tree.cert.len();
+                    grew |= at_root.is_some_and(|r| here > r);
+                    at_root.get_or_insert(here);
+                    if live.is_empty() {
+                        break;
+                    }
+                    st.tree_push(live[(rng.next_u64() % live.len() as u64) as usize]);
+                }
+                while !st.tree.is_empty() {
+                    st.tree_pop();
+                }
+                let at_root = at_root.expect("the root was visited");
+                assert_eq!(st.tree.cert.len(), at_root, "back at the root");
+            }
+            assert!(grew, "the excursions computed certificates");
+            let first = (0..nc as u32)
+                .find(|&c| st.is_allowed(c))
+                .expect("an action");
+            st.apply(first);
+        }
     }
 }
