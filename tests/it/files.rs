@@ -694,3 +694,20 @@ fn report_escapes_mesh_names_and_keeps_figures_apart() {
         assert!(md.contains(&format!("]({f})")), "{f} not linked");
     }
 }
+
+/// Item 13: `merge --out FILE` names the problem (it said `File exists (os error 17)`,
+/// exit 1).
+#[test]
+fn merge_into_a_file_is_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    small_sweep(tmp.path(), "d", &["--no-report"]);
+    std::fs::write(tmp.path().join("m"), "mine").unwrap();
+    let o = run_in(tmp.path(), &["merge", "d", "--out", "m"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--out m: is a regular file, not a directory"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(tmp.path().join("m")).unwrap(), b"mine");
+}
