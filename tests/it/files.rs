@@ -695,6 +695,34 @@ fn report_escapes_mesh_names_and_keeps_figures_apart() {
     }
 }
 
+/// Item 13: a duplicate node tag is reported on its own line, with the line of the first
+/// (it was reported at the `$Nodes` header line).
+#[test]
+fn a_duplicate_node_tag_is_reported_on_its_own_line() {
+    use quadrecomb::mesh::msh::read_bytes;
+    let edit = |file: &str, line: usize, text: &str| -> Vec<u8> {
+        let s =
+            std::fs::read_to_string(crate::util::repo_path(&format!("tests/data/{file}"))).unwrap();
+        let mut lines: Vec<&str> = s.lines().collect();
+        lines[line - 1] = text;
+        (lines.join("\n") + "\n").into_bytes()
+    };
+    // MSH 2.2: node 20 (line 25) given the tag of node 7 (line 12).
+    let bytes = edit("two_squares_22_ascii.msh", 25, "7 0.28 0.62 0");
+    let err = read_bytes("a.msh", &bytes).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "a.msh:25: node tag 7 is defined twice in $Nodes (first on line 12)"
+    );
+    // MSH 4.1: the tag of block 2 (line 28) given the tag of block 1 (line 25).
+    let bytes = edit("two_squares_41_ascii.msh", 28, "1");
+    let err = read_bytes("b.msh", &bytes).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "b.msh:28: node tag 1 is defined twice in $Nodes (first on line 25)"
+    );
+}
+
 /// Item 13: `merge --out FILE` names the problem (it said `File exists (os error 17)`,
 /// exit 1).
 #[test]
