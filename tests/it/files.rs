@@ -723,6 +723,30 @@ fn a_duplicate_node_tag_is_reported_on_its_own_line() {
     );
 }
 
+/// Item 13: a triangle 1e200 long and 1e-200 high (area 0.5) is degenerate for its shape,
+/// not "zero area" as it was called; a collinear one still has zero area.
+#[test]
+fn a_flat_triangle_is_not_called_zero_area() {
+    let mesh = |c: &str| {
+        format!(
+            "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 {c}\n3 0 1e-200 0\n\
+             $EndNodes\n$Elements\n1\n1 2 2 0 1 1 2 3\n$EndElements\n"
+        )
+    };
+    let err = quadrecomb::mesh::msh::read_bytes("n.msh", mesh("1e200 0 0").as_bytes())
+        .unwrap_err()
+        .to_string();
+    assert!(!err.contains("zero area"), "{err}");
+    assert!(
+        err.contains("flat to within rounding: its height is about 1e-400 times its longest edge"),
+        "{err}"
+    );
+    let err = quadrecomb::mesh::msh::read_bytes("z.msh", mesh("0 2e-200 0").as_bytes())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("degenerate (zero area)"), "{err}");
+}
+
 /// Item 13: `merge --out FILE` names the problem (it said `File exists (os error 17)`,
 /// exit 1).
 #[test]

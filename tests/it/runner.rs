@@ -265,7 +265,11 @@ fn overwrite_replaces_an_earlier_sweep_with_another_configuration() {
     );
     // The sweep's report listed its figures: --overwrite removes those (and keeps a file
     // it did not write).
-    assert!(run_in(dir, &["report", "out", "--no-pictures"]).status.success());
+    assert!(
+        run_in(dir, &["report", "out", "--no-pictures"])
+            .status
+            .success()
+    );
     let listed = std::fs::read_to_string(dir.join("out/report-files.txt")).unwrap();
     let figure = dir.join("out").join(listed.lines().next().unwrap());
     assert!(figure.is_file());
