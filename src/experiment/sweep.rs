@@ -136,14 +136,13 @@ impl SweepConfig {
             ));
         }
         // Counted before the run list is built (it is held in memory).
-        let per_mesh: u64 = (self.algos.iter())
-            .map(|a| match a.as_str() {
-                "optimum" => 1,
-                a if has_horizon(a) => self.horizons.len() as u64 * u64::from(self.runs),
-                _ => u64::from(self.baseline_runs),
-            })
-            .sum();
-        let total = per_mesh.saturating_mul(self.meshes.len() as u64);
+        let total = super::plan::planned_runs(
+            self.meshes.len(),
+            &self.algos,
+            self.horizons.len(),
+            self.runs,
+            self.baseline_runs,
+        );
         if total > MAX_RUNS {
             return bad(format!(
                 "the sweep has {total} runs (--runs {}, --baseline-runs {}, {} horizon(s), {} \
@@ -281,21 +280,19 @@ pub fn cached_optimum(
     let text = (!recompute)
         .then(|| std::fs::read_to_string(&path).ok())
         .flatten();
-    if let Some(text) = text {
-        if let Ok(cached) = serde_json::from_str::<CachedOptimum>(&text) {
-            if cached.optimum.mesh_hash == entry.hash
-                && cached.optimum.eta_hash == eta
-                && cached.verify(mesh, table)
-            {
-                return Ok(OptimumEntry {
-                    mesh: entry.name.clone(),
-                    // JSON parsing of floats may be off by an ulp: restore the exact value,
-                    // so that quality_pct is bit-identical whether the optimum was cached.
-                    quality: f64::from_bits(cached.quality_bits),
-                    ..cached.optimum
-                });
-            }
-        }
+    if let Some(text) = text
+        && let Ok(cached) = serde_json::from_str::<CachedOptimum>(&text)
+        && cached.optimum.mesh_hash == entry.hash
+        && cached.optimum.eta_hash == eta
+        && cached.verify(mesh, table)
+    {
+        return Ok(OptimumEntry {
+            mesh: entry.name.clone(),
+            // JSON parsing of floats may be off by an ulp: restore the exact value,
+            // so that quality_pct is bit-identical whether the optimum was cached.
+            quality: f64::from_bits(cached.quality_bits),
+            ..cached.optimum
+        });
     }
     let opt = crate::search::optimum::solve(mesh, table);
     let found = OptimumEntry {
