@@ -940,3 +940,21 @@ fn fuzz_manifest_with_huge_runs_is_refused() {
         );
     }
 }
+
+/// Found by the record fuzz campaign: a run whose `time_s` is 1e308 (finite, so a valid
+/// record) made the time plot's log axis end at infinity and `report` loop forever.
+#[test]
+fn fuzz_a_huge_time_is_plotted() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = small_sweep(tmp.path(), "d", &["--no-report"]);
+    let runs = d.join("runs.jsonl");
+    let mut lines = lines_of(&runs);
+    let i = lines
+        .iter()
+        .position(|l| l.contains("\"horizon\":2"))
+        .unwrap();
+    lines[i] = edit_line(&lines[i], |v| v["time_s"] = 1e308.into());
+    std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
+    let o = run_limited(tmp.path(), "true", &["report", "d", "--no-pictures"], 30);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
