@@ -266,7 +266,8 @@ pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
 
 /// The optimum of `mesh` with `table`'s eta: read from `out/optimum-cache/<mesh hash>.json`
 /// when it was computed from the same eta by the same version and its matching checks out
-/// ([`CachedOptimum::verify`]), else (and always with `recompute`) computed and written there.
+/// (disjoint candidates of the table whose eta sums bit for bit to the recorded quality), else
+/// (and always with `recompute`) computed and written there.
 pub fn cached_optimum(
     out: &Path,
     mesh: &Mesh,
