@@ -197,12 +197,12 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             r.quality, r.quads
         ));
     }
-    if let Some(pct) = r.quality_pct
-        && (!pct.is_finite() || pct < 0.0)
-    {
-        return Err(format!(
-            "quality_pct {pct} is not a finite non-negative number"
-        ));
+    if let Some(pct) = r.quality_pct {
+        if !pct.is_finite() || pct < 0.0 {
+            return Err(format!(
+                "quality_pct {pct} is not a finite non-negative number"
+            ));
+        }
     }
     let Some(opt) = optimum else {
         return Ok(());
@@ -222,14 +222,15 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             r.quality, opt.quality
         ));
     }
-    if let Some(pct) = r.quality_pct
-        && opt.quality > 0.0
-        && (pct - 100.0 * r.quality / opt.quality).abs() > 1e-6 * pct.abs().max(1.0)
-    {
-        return Err(format!(
-            "quality_pct {pct} is not 100 x quality {} / optimum {}",
-            r.quality, opt.quality
-        ));
+    if let Some(pct) = r.quality_pct {
+        if opt.quality > 0.0
+            && (pct - 100.0 * r.quality / opt.quality).abs() > 1e-6 * pct.abs().max(1.0)
+        {
+            return Err(format!(
+                "quality_pct {pct} is not 100 x quality {} / optimum {}",
+                r.quality, opt.quality
+            ));
+        }
     }
     Ok(())
 }
