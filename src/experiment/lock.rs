@@ -1,12 +1,12 @@
 //! One writer per results directory: a sweep holds an exclusive advisory lock of the
-//! operating system on `DIR/.lock` (`flock`, through [`File::try_lock`]) for as long as it
+//! operating system on `DIR/.lock` (`flock(2)`; `File::try_lock` off Unix) for as long as it
 //! runs. A second sweep into the same directory (two `--resume` at once, two shards given the
 //! same `--out`) is refused rather than left to interleave its records. The kernel releases
 //! the lock when its process ends, however it ends (`kill -9` included), so a stale lock
 //! cannot exist: a leftover `.lock` file, whatever it holds, is simply locked again. The file
 //! holds the holder's process id, for messages only.
 
-use std::fs::{File, OpenOptions, TryLockError};
+use std::fs::{File, OpenOptions};
 use std::io::{Read, Seek, Write};
 use std::path::{Path, PathBuf};
 
@@ -32,14 +32,14 @@ impl DirLock {
         // A holder that finishes removes the file it locked; one that opened that file just
         // before locks a file no longer in the directory and must try again on the new one.
         for _ in 0..100 {
-            if let Ok(meta) = std::fs::symlink_metadata(&path) {
-                if !meta.is_file() {
-                    return Err(ExperimentError::Invalid(format!(
-                        "{}: is {}, not a sweep's lock file; remove it (no sweep uses it)",
-                        path.display(),
-                        crate::mesh::file_kind(&meta)
-                    )));
-                }
+            if let Ok(meta) = std::fs::symlink_metadata(&path)
+                && !meta.is_file()
+            {
+                return Err(ExperimentError::Invalid(format!(
+                    "{}: is {}, not a sweep's lock file; remove it (no sweep uses it)",
+                    path.display(),
+                    crate::mesh::file_kind(&meta)
+                )));
             }
             let mut file = OpenOptions::new()
                 .read(true)
@@ -48,9 +48,9 @@ impl DirLock {
                 .truncate(false)
                 .open(&path)
                 .map_err(io)?;
-            match file.try_lock() {
-                Ok(()) => {}
-                Err(TryLockError::WouldBlock) => {
+            match try_lock(&file) {
+                Ok(true) => {}
+                Ok(false) => {
                     let mut text = String::new();
                     let _ = file.read_to_string(&mut text);
                     return Err(ExperimentError::Busy {
@@ -58,7 +58,7 @@ impl DirLock {
                         pid: text.trim().parse().ok(),
                     });
                 }
-                Err(TryLockError::Error(e)) => return Err(io(e)),
+                Err(e) => return Err(io(e)),
             }
             if !still_at(&file, &path) {
                 continue;
@@ -75,6 +75,28 @@ impl DirLock {
             dir: dir.to_path_buf(),
             pid: None,
         })
+    }
+}
+
+/// Takes an exclusive lock on `file` without waiting: `Ok(false)` when another open file
+/// holds it.
+#[cfg(unix)]
+fn try_lock(file: &File) -> std::io::Result<bool> {
+    use rustix::fs::{FlockOperation, flock};
+    match flock(file, FlockOperation::NonBlockingLockExclusive) {
+        Ok(()) => Ok(true),
+        Err(e) if e == rustix::io::Errno::WOULDBLOCK => Ok(false),
+        Err(e) => Err(e.into()),
+    }
+}
+
+#[cfg(not(unix))]
+#[allow(clippy::incompatible_msrv)] // File::try_lock is Rust 1.89; Unix builds do not use it.
+fn try_lock(file: &File) -> std::io::Result<bool> {
+    match file.try_lock() {
+        Ok(()) => Ok(true),
+        Err(std::fs::TryLockError::WouldBlock) => Ok(false),
+        Err(std::fs::TryLockError::Error(e)) => Err(e),
     }
 }
 

@@ -217,10 +217,40 @@ impl Manifest {
     pub fn read(dir: &Path) -> Result<Manifest, ExperimentError> {
         let path = dir.join(MANIFEST_FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| ExperimentError::io(&path, e))?;
-        serde_json::from_str(&text).map_err(|e| ExperimentError::Corrupt {
+        let m: Manifest = serde_json::from_str(&text).map_err(|e| ExperimentError::Corrupt {
             path: path.clone(),
             message: e.to_string(),
-        })
+        })?;
+        // What a sweep would have refused is refused here too, before a run list is built
+        // from it (a manifest with runs 4294967295 made report and merge plan 8.6e9 runs).
+        let s = &m.spec;
+        let runs = super::plan::planned_runs(
+            s.meshes.len(),
+            &s.algos,
+            s.horizons.len(),
+            s.runs,
+            s.baseline_runs,
+        );
+        let why = if s.horizons.len() > super::sweep::MAX_HORIZONS {
+            Some(format!(
+                "{} horizons, more than a sweep takes ({})",
+                s.horizons.len(),
+                super::sweep::MAX_HORIZONS
+            ))
+        } else if runs > super::sweep::MAX_RUNS {
+            Some(format!(
+                "its spec makes {runs} runs, more than a sweep takes ({})",
+                super::sweep::MAX_RUNS
+            ))
+        } else if m.optimum.len() > s.meshes.len() {
+            Some("more optimum entries than meshes".to_string())
+        } else {
+            None
+        };
+        match why {
+            Some(message) => Err(ExperimentError::Corrupt { path, message }),
+            None => Ok(m),
+        }
     }
 
     /// Writes `dir/manifest.json` (through a temporary file, so a kill never leaves half of it).

@@ -29,6 +29,15 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     if parts.is_empty() {
         return Err(ExperimentError::Merge("no directories to merge".into()));
     }
+    if let Ok(meta) = std::fs::metadata(out) {
+        if !meta.is_dir() {
+            return Err(ExperimentError::Merge(format!(
+                "--out {}: is {}, not a directory (merge writes a results directory)",
+                out.display(),
+                crate::mesh::file_kind(&meta)
+            )));
+        }
+    }
     let mut manifests = Vec::new();
     for p in parts {
         if !p.is_dir() {

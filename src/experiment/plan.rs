@@ -36,6 +36,25 @@ impl Job {
     }
 }
 
+/// The number of runs [`plan`] makes, counted without making them (saturating).
+pub fn planned_runs(
+    meshes: usize,
+    algos: &[String],
+    horizons: usize,
+    runs: u32,
+    baseline_runs: u32,
+) -> u64 {
+    let per_mesh = algos
+        .iter()
+        .map(|a| match a.as_str() {
+            "optimum" => 1,
+            a if has_horizon(a) => (horizons as u64).saturating_mul(u64::from(runs)),
+            _ => u64::from(baseline_runs),
+        })
+        .fold(0u64, u64::saturating_add);
+    per_mesh.saturating_mul(meshes as u64)
+}
+
 /// Every run of a sweep, in canonical order: by mesh, then algorithm (spec order), then
 /// horizon, then run index. `optimum` is one run per mesh; `greedy` and `greedy-nocrit` are
 /// `baseline_runs` runs; `uniform` and `selective` are `runs` runs per horizon.

@@ -139,14 +139,13 @@ impl SweepConfig {
             ));
         }
         // Counted before the run list is built (it is held in memory).
-        let per_mesh: u64 = (self.algos.iter())
-            .map(|a| match a.as_str() {
-                "optimum" => 1,
-                a if has_horizon(a) => self.horizons.len() as u64 * u64::from(self.runs),
-                _ => u64::from(self.baseline_runs),
-            })
-            .sum();
-        let total = per_mesh.saturating_mul(self.meshes.len() as u64);
+        let total = super::plan::planned_runs(
+            self.meshes.len(),
+            &self.algos,
+            self.horizons.len(),
+            self.runs,
+            self.baseline_runs,
+        );
         if total > MAX_RUNS {
             return bad(format!(
                 "the sweep has {total} runs (--runs {}, --baseline-runs {}, {} horizon(s), {} \
@@ -275,7 +274,8 @@ pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
 
 /// The optimum of `mesh` with `table`'s eta: read from `out/optimum-cache/<mesh hash>.json`
 /// when it was computed from the same eta by the same version and its matching checks out
-/// ([`CachedOptimum::verify`]), else (and always with `recompute`) computed and written there.
+/// (disjoint candidates of the table whose eta sums bit for bit to the recorded quality), else
+/// (and always with `recompute`) computed and written there.
 pub fn cached_optimum(
     out: &Path,
     mesh: &Mesh,

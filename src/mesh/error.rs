@@ -33,8 +33,13 @@ pub enum MeshError {
     UnknownNode { element: u64, node: u64 },
     #[error("element {element} uses node {node} twice")]
     RepeatedNode { element: u64, node: u64 },
-    #[error("triangle {element} is degenerate (zero area): nodes {nodes:?}")]
-    DegenerateTriangle { element: u64, nodes: [u64; 3] },
+    #[error("triangle {element} is degenerate ({}): nodes {nodes:?}", flatness(*log10_height))]
+    DegenerateTriangle {
+        element: u64,
+        nodes: [u64; 3],
+        /// log10 of its smallest height over its longest edge (-inf for zero area).
+        log10_height: f64,
+    },
     #[error(
         "element tag {tag} is given to two elements (tags must be unique: Gmsh would keep only the last one)"
     )]
@@ -76,4 +81,17 @@ pub enum ReadError {
     },
     #[error("{path}: {source}")]
     Mesh { path: PathBuf, source: MeshError },
+}
+
+/// Why a triangle of relative height `10^lg` is degenerate, in words.
+fn flatness(lg: f64) -> String {
+    if lg == f64::NEG_INFINITY || lg.is_nan() {
+        "zero area".into()
+    } else {
+        format!(
+            "flat to within rounding: its height is about 1e{:.0} times its longest edge, at \
+             most 1e-14, so its angles cannot be told from 0 and 180 degrees",
+            lg.round()
+        )
+    }
 }

@@ -105,6 +105,7 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             return Err(MeshError::DegenerateTriangle {
                 element: data.triangle_ids[t],
                 nodes: tri.map(|v| data.vertex_ids[v as usize]),
+                log10_height: log10_height(a, b, c),
             });
         }
     }
@@ -363,6 +364,30 @@ pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
+}
+
+/// log10 of the smallest height of triangle `abc` over its longest edge, without
+/// under- or overflow (a triangle 1e200 long and 1e-200 high has area 0.5 and ratio 1e-400,
+/// which no f64 holds): each edge vector is scaled by its own largest component and the
+/// scales are added back as logarithms. -inf when the area is zero.
+fn log10_height(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    let unit = |v: [f64; 3]| {
+        let m = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if m > 0.0 {
+            (v.map(|x| x / m), m.log10())
+        } else {
+            (v, f64::NEG_INFINITY)
+        }
+    };
+    let (u, lu) = unit(sub(b, a));
+    let (w, lw) = unit(sub(c, a));
+    let (e, le) = unit(sub(c, b));
+    // 2 area = |u x w| 10^(lu + lw); longest edge^2 = max |.|^2 10^(2 l).
+    let edge = [(u, lu), (w, lw), (e, le)]
+        .iter()
+        .map(|(v, l)| 0.5 * dot(*v, *v).log10() + l)
+        .fold(f64::NEG_INFINITY, f64::max);
+    norm(cross(u, w)).log10() + lu + lw - 2.0 * edge
 }
 
 #[cfg(test)]

@@ -255,3 +255,29 @@ pub fn escape(s: &str) -> String {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn md_escape_leaves_no_markup() {
+        assert_eq!(
+            md_escape("<img src=x onerror=alert(2)>"),
+            r"\<img src=x onerror=alert(2)\>"
+        );
+        assert_eq!(
+            md_escape("a_b *c* [d](e) `f` | g"),
+            r"a\_b \*c\* \[d\](e) \`f\` \| g"
+        );
+        assert_eq!(md_escape("# h"), r"\# h");
+        assert_eq!(md_escape("- x"), r"\- x");
+        assert_eq!(md_escape("1. x"), r"1\. x");
+        assert_eq!(md_escape("85.1"), "85.1");
+        assert_eq!(md_escape("a\nb\r\nc"), "a b  c");
+        assert_eq!(
+            md_escape("selective h=3 (30 runs)"),
+            "selective h=3 (30 runs)"
+        );
+    }
+}

@@ -65,6 +65,9 @@ pub fn boxplot_svg(
         );
         let x_range = (hmin as f64 - 0.6)..(hmax as f64 + 0.6);
         let (mut lo, mut hi) = value_range(boxes, extras);
+        // Finite margins however large the values (a time of 1e308 made the log axis end at
+        // infinity, and plotters looped forever over its decades).
+        (lo, hi) = (lo.clamp(-1e300, 1e300), hi.clamp(-1e300, 1e300));
         if log_y {
             // Half a decade of margin on a log axis; time is positive.
             lo = (lo.max(1e-9)) / 1.5;

@@ -712,3 +712,267 @@ fn report_escapes_mesh_names_and_keeps_figures_apart() {
         assert!(md.contains(&format!("]({f})")), "{f} not linked");
     }
 }
+
+/// Item 13: a duplicate node tag is reported on its own line, with the line of the first
+/// (it was reported at the `$Nodes` header line).
+#[test]
+fn a_duplicate_node_tag_is_reported_on_its_own_line() {
+    use quadrecomb::mesh::msh::read_bytes;
+    let edit = |file: &str, line: usize, text: &str| -> Vec<u8> {
+        let s =
+            std::fs::read_to_string(crate::util::repo_path(&format!("tests/data/{file}"))).unwrap();
+        let mut lines: Vec<&str> = s.lines().collect();
+        lines[line - 1] = text;
+        (lines.join("\n") + "\n").into_bytes()
+    };
+    // MSH 2.2: node 20 (line 25) given the tag of node 7 (line 12).
+    let bytes = edit("two_squares_22_ascii.msh", 25, "7 0.28 0.62 0");
+    let err = read_bytes("a.msh", &bytes).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "a.msh:25: node tag 7 is defined twice in $Nodes (first on line 12)"
+    );
+    // MSH 4.1: the tag of block 2 (line 28) given the tag of block 1 (line 25).
+    let bytes = edit("two_squares_41_ascii.msh", 28, "1");
+    let err = read_bytes("b.msh", &bytes).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "b.msh:28: node tag 1 is defined twice in $Nodes (first on line 25)"
+    );
+}
+
+/// Item 13: a triangle 1e200 long and 1e-200 high (area 0.5) is degenerate for its shape,
+/// not "zero area" as it was called; a collinear one still has zero area.
+#[test]
+fn a_flat_triangle_is_not_called_zero_area() {
+    let mesh = |c: &str| {
+        format!(
+            "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 {c}\n3 0 1e-200 0\n\
+             $EndNodes\n$Elements\n1\n1 2 2 0 1 1 2 3\n$EndElements\n"
+        )
+    };
+    let err = quadrecomb::mesh::msh::read_bytes("n.msh", mesh("1e200 0 0").as_bytes())
+        .unwrap_err()
+        .to_string();
+    assert!(!err.contains("zero area"), "{err}");
+    assert!(
+        err.contains("flat to within rounding: its height is about 1e-400 times its longest edge"),
+        "{err}"
+    );
+    let err = quadrecomb::mesh::msh::read_bytes("z.msh", mesh("0 2e-200 0").as_bytes())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("degenerate (zero area)"), "{err}");
+}
+
+/// Item 13: `merge --out FILE` names the problem (it said `File exists (os error 17)`,
+/// exit 1).
+#[test]
+fn merge_into_a_file_is_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    small_sweep(tmp.path(), "d", &["--no-report"]);
+    std::fs::write(tmp.path().join("m"), "mine").unwrap();
+    let o = run_in(tmp.path(), &["merge", "d", "--out", "m"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--out m: is a regular file, not a directory"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(tmp.path().join("m")).unwrap(), b"mine");
+}
+
+/// One mutation of a results directory's files: structure-aware (a field of a record or of
+/// the manifest set to an odd value, lines duplicated, dropped, swapped) or raw bytes.
+fn mutate(rng: &mut rand_chacha::ChaCha8Rng, runs: &mut Vec<String>, manifest: &mut String) {
+    use rand::RngExt;
+    use serde_json::{Value, json};
+    let odd = |rng: &mut rand_chacha::ChaCha8Rng| -> Value {
+        match rng.random_range(0..14) {
+            0 => json!(0),
+            1 => json!(-1),
+            2 => json!(1e308),
+            3 => json!(-1e308),
+            4 => json!(u64::MAX),
+            5 => json!(u32::MAX),
+            6 => json!(150.0),
+            7 => json!(null),
+            8 => json!(""),
+            9 => json!("<img src=x onerror=alert(1)>|*_`#"),
+            10 => json!([1, 2]),
+            11 => json!({"a": 1}),
+            12 => json!(rng.random_range(-10.0..2000.0)),
+            _ => json!(rng.random_range(0u32..100)),
+        }
+    };
+    let n = runs.len();
+    match rng.random_range(0..10) {
+        0..=3 if n > 0 => {
+            let i = rng.random_range(0..n);
+            if let Ok(mut v) = serde_json::from_str::<Value>(&runs[i]) {
+                let keys: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
+                let k = &keys[rng.random_range(0..keys.len())];
+                v[k] = odd(rng);
+                runs[i] = v.to_string();
+            }
+        }
+        4 if n > 0 => {
+            let i = rng.random_range(0..n);
+            let line = runs[i].clone();
+            runs.insert(rng.random_range(0..=n), line);
+        }
+        5 if n > 0 => {
+            runs.remove(rng.random_range(0..n));
+        }
+        6 if n > 1 => {
+            let (i, j) = (rng.random_range(0..n), rng.random_range(0..n));
+            runs.swap(i, j);
+        }
+        7 => {
+            if let Ok(mut v) = serde_json::from_str::<Value>(manifest) {
+                let paths: [&[&str]; 8] = [
+                    &["optimum", "0", "quality"],
+                    &["optimum", "0", "quads"],
+                    &["spec", "runs"],
+                    &["spec", "horizons"],
+                    &["spec", "meshes", "0", "name"],
+                    &["spec", "meshes", "0", "triangles"],
+                    &["spec", "algos"],
+                    &["shard"],
+                ];
+                let path = paths[rng.random_range(0..paths.len())];
+                let mut at = &mut v;
+                for p in &path[..path.len() - 1] {
+                    at = match p.parse::<usize>() {
+                        Ok(i) => &mut at[i],
+                        Err(_) => &mut at[*p],
+                    };
+                }
+                at[path[path.len() - 1]] = odd(rng);
+                *manifest = v.to_string();
+            }
+        }
+        8 if n > 0 => {
+            // Raw bytes: cut a line or splice random bytes into it.
+            let i = rng.random_range(0..n);
+            let mut b = runs[i].clone().into_bytes();
+            let at = rng.random_range(0..=b.len());
+            if rng.random_bool(0.5) {
+                b.truncate(at);
+            } else {
+                let junk: Vec<u8> = (0..rng.random_range(1..8)).map(|_| rng.random()).collect();
+                b.splice(at..at, junk);
+            }
+            runs[i] = String::from_utf8_lossy(&b).into_owned();
+        }
+        _ => {
+            let mut b = manifest.clone().into_bytes();
+            b.truncate(rng.random_range(0..=b.len()));
+            *manifest = String::from_utf8_lossy(&b).into_owned();
+        }
+    }
+}
+
+/// Fuzz campaign on what `report` and `merge` read: record files (and manifests) mutated
+/// from a real sweep's, 1 to 4 mutations each, read by the report (without pictures) and by
+/// merge. No case may panic or take more than 30 s; most are refused with a message. Cases:
+/// `QUADRECOMB_RECORD_FUZZ` (default 200; the campaign of docs/io.md runs 10^4).
+#[test]
+fn fuzz_report_and_merge_never_panic() {
+    use rand::{RngExt, SeedableRng};
+    let cases: u64 = std::env::var("QUADRECOMB_RECORD_FUZZ")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(200);
+    let tmp = tempfile::tempdir().unwrap();
+    let base = small_sweep(tmp.path(), "base", &["--algo", "optimum", "--no-report"]);
+    let runs0 = lines_of(&base.join("runs.jsonl"));
+    let manifest0 = std::fs::read_to_string(base.join("manifest.json")).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(crate::util::SEED);
+    let (mut refused, mut accepted) = (0u64, 0u64);
+    let start = std::time::Instant::now();
+    for case in 0..cases {
+        let mut runs = runs0.clone();
+        let mut manifest = manifest0.clone();
+        for _ in 0..rng.random_range(1..=4) {
+            mutate(&mut rng, &mut runs, &mut manifest);
+        }
+        let dir = tmp.path().join(format!("c{case}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("runs.jsonl"), runs.join("\n") + "\n").unwrap();
+        std::fs::write(dir.join("manifest.json"), &manifest).unwrap();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let d = dir.clone();
+        std::thread::spawn(move || {
+            let opts = quadrecomb::report::ReportOptions {
+                pictures: false,
+                ..Default::default()
+            };
+            let r = std::panic::catch_unwind(|| {
+                let report = quadrecomb::report::write(&d, &opts).is_ok();
+                let merge =
+                    quadrecomb::experiment::merge::merge(std::slice::from_ref(&d), &d.join("m"));
+                (report, merge.is_ok())
+            });
+            let _ = tx.send(r);
+        });
+        match rx.recv_timeout(std::time::Duration::from_secs(30)) {
+            Ok(Ok((r, m))) => {
+                accepted += u64::from(r) + u64::from(m);
+                refused += u64::from(!r) + u64::from(!m);
+            }
+            Ok(Err(_)) => panic!("case {case} panicked: runs {runs:?}, manifest {manifest}"),
+            Err(_) => panic!("case {case} hung: runs {runs:?}, manifest {manifest}"),
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    eprintln!(
+        "record fuzz: {cases} cases, {accepted} reads accepted, {refused} refused, {:.1} s",
+        start.elapsed().as_secs_f64()
+    );
+    assert!(refused > 0 && accepted > 0);
+}
+
+/// Found by the record fuzz campaign: a manifest whose `runs` is 4294967295 made `report`
+/// and `merge` build a run list of 8.6e9 runs (a hang, then out of memory); it is refused as
+/// corrupt, as the sweep would have refused the arguments.
+#[test]
+fn fuzz_manifest_with_huge_runs_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = small_sweep(tmp.path(), "d", &["--no-report"]);
+    let path = d.join("manifest.json");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("\"runs\": 3,", "\"runs\": 4294967295,");
+    std::fs::write(&path, text).unwrap();
+    for cmd in [
+        &["report", "d", "--no-pictures"][..],
+        &["merge", "d", "--out", "m"],
+    ] {
+        let o = run_limited(tmp.path(), "ulimit -v 4000000", cmd, 20);
+        assert_eq!(o.status.code(), Some(2), "{cmd:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("makes 8589934591 runs, more than a sweep takes (10000000)"),
+            "{}",
+            stderr(&o)
+        );
+    }
+}
+
+/// Found by the record fuzz campaign: a run whose `time_s` is 1e308 (finite, so a valid
+/// record) made the time plot's log axis end at infinity and `report` loop forever.
+#[test]
+fn fuzz_a_huge_time_is_plotted() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = small_sweep(tmp.path(), "d", &["--no-report"]);
+    let runs = d.join("runs.jsonl");
+    let mut lines = lines_of(&runs);
+    let i = lines
+        .iter()
+        .position(|l| l.contains("\"horizon\":2"))
+        .unwrap();
+    lines[i] = edit_line(&lines[i], |v| v["time_s"] = 1e308.into());
+    std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
+    let o = run_limited(tmp.path(), "true", &["report", "d", "--no-pictures"], 30);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

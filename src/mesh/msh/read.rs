@@ -247,6 +247,7 @@ fn show(t: &[u8]) -> String {
     if t.len() > 40 { format!("{s}...") } else { s }
 }
 
+#[derive(Clone)]
 struct Parser<'a> {
     path: &'a Path,
     b: &'a [u8],
@@ -584,6 +585,8 @@ fn cap(count: u64, min_bytes: usize, bytes_left: usize) -> usize {
 struct Content {
     data: MeshData,
     node_tags: Vec<u64>,
+    /// Where each node tag is (offsets), noted only when a duplicate tag is looked for.
+    tag_pos: Option<Vec<usize>>,
     map: Option<NodeMap>,
     /// Skipped elements: count per Gmsh type and whether they were on a partition
     /// interface (a surface inside a volume; see `interfaces`).
@@ -736,6 +739,27 @@ impl ModelParts {
 }
 
 impl Content {
+    fn new() -> Content {
+        Content {
+            data: MeshData::default(),
+            node_tags: Vec::new(),
+            tag_pos: None,
+            map: None,
+            skipped: BTreeMap::new(),
+            parents: HashMap::new(),
+            interfaces: HashSet::new(),
+            model: ModelParts::default(),
+        }
+    }
+
+    /// Notes where the node tag just pushed is, when asked to (see [`duplicate_node`]).
+    #[inline]
+    fn note_tag(&mut self, pos: usize) {
+        if let Some(v) = &mut self.tag_pos {
+            v.push(pos);
+        }
+    }
+
     /// Counts `n` skipped elements of type `etype` (on a partition interface or not).
     fn skip(&mut self, etype: i64, n: u64, on_interface: bool) {
         *self.skipped.entry((etype, on_interface)).or_default() += n as usize;
@@ -837,30 +861,19 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
     }
     p.end(fmt, &|| "the format line".into())?;
 
-    let mut c = Content {
-        data: MeshData::default(),
-        node_tags: Vec::new(),
-        map: None,
-        skipped: BTreeMap::new(),
-        parents: HashMap::new(),
-        interfaces: HashSet::new(),
-        model: ModelParts::default(),
-    };
+    let mut c = Content::new();
     while let Some((start, name)) = p.token() {
         match name {
             b"$Nodes" | b"$ParametricNodes" => {
                 if c.map.is_some() {
                     return Err(p.err(start, "a second $Nodes section"));
                 }
+                let at_nodes = p.clone();
                 let section = if name == b"$Nodes" {
-                    match (version, p.binary) {
-                        (MshVersion::V41, _) => nodes41(&mut p, &mut c)?,
-                        (MshVersion::V22, false) => nodes22_ascii(&mut p, &mut c)?,
-                        (MshVersion::V22, true) => nodes22_binary(&mut p, &mut c)?,
-                    }
+                    read_nodes(&mut p, &mut c, version, false)?;
                     "$Nodes"
                 } else if version == MshVersion::V22 {
-                    parametric_nodes22(&mut p, &mut c)?;
+                    read_nodes(&mut p, &mut c, version, true)?;
                     "$ParametricNodes"
                 } else {
                     return Err(p.err(
@@ -870,7 +883,23 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
                 };
                 p.end(section, &|| format!("{} nodes", c.node_tags.len()))?;
                 let map = NodeMap::new(&c.node_tags).map_err(|t| {
-                    p.err(start, format!("node tag {t} is defined twice in $Nodes"))
+                    let parametric = section == "$ParametricNodes";
+                    match duplicate_node(&at_nodes, version, parametric, t) {
+                        Some((first, second)) => {
+                            let first = if p.binary {
+                                format!("byte {first}")
+                            } else {
+                                format!("line {}", p.line_of(first))
+                            };
+                            p.err(
+                                second,
+                                format!(
+                                    "node tag {t} is defined twice in {section} (first on {first})"
+                                ),
+                            )
+                        }
+                        None => p.err(start, format!("node tag {t} is defined twice in {section}")),
+                    }
                 })?;
                 c.data.vertex_ids = std::mem::take(&mut c.node_tags);
                 c.map = Some(map);
@@ -1167,6 +1196,35 @@ fn header41(p: &mut Parser<'_>, s: &str, item: &str) -> Res<(usize, u64, u64)> {
     Ok((hp, blocks, total))
 }
 
+/// Reads a `$Nodes` (or, in MSH 2.2, `$ParametricNodes`) section after its name.
+fn read_nodes(p: &mut Parser<'_>, c: &mut Content, v: MshVersion, parametric: bool) -> Res<()> {
+    match (v, p.binary) {
+        _ if parametric => parametric_nodes22(p, c),
+        (MshVersion::V41, _) => nodes41(p, c),
+        (MshVersion::V22, false) => nodes22_ascii(p, c),
+        (MshVersion::V22, true) => nodes22_binary(p, c),
+    }
+}
+
+/// Where the first two nodes tagged `tag` are, by reading the section again from `p0` and
+/// noting where each tag is (only on this error path: no offsets are kept otherwise).
+fn duplicate_node(
+    p0: &Parser<'_>,
+    v: MshVersion,
+    parametric: bool,
+    tag: u64,
+) -> Option<(usize, usize)> {
+    let mut p = p0.clone();
+    let mut c = Content::new();
+    c.tag_pos = Some(Vec::new());
+    read_nodes(&mut p, &mut c, v, parametric).ok()?;
+    let pos = c.tag_pos?;
+    let mut at = (c.node_tags.iter().zip(&pos))
+        .filter(|(t, _)| **t == tag)
+        .map(|(_, &p)| p);
+    Some((at.next()?, at.next()?))
+}
+
 /// The `$Nodes` section of MSH 4.1, in either encoding: the headers read alike, the
 /// blocks' tags and coordinates per encoding.
 fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
@@ -1275,6 +1333,7 @@ fn node_block41_ascii(p: &mut Parser<'_>, c: &mut Content, b: &NodeBlock41) -> R
         p.entry_start();
         p.entry_end(&|| format!("node tag {tag}"))?;
         c.node_tags.push(tag);
+        c.note_tag(p.pos);
     }
     let first = c.node_tags.len() - n as usize;
     for i in 0..n as usize {
@@ -1303,9 +1362,13 @@ fn node_block41_binary(p: &mut Parser<'_>, c: &mut Content, b: &NodeBlock41) -> 
     let s = "$Nodes";
     let (blk, n, extra) = (b.index, b.len, b.extra);
     let what_tags = || format!("the node tags of block {}", blk + 1);
+    let tp = p.pos;
     let tags = p.take_array(n, 8, s, &what_tags)?;
     c.node_tags
         .extend(tags.chunks_exact(8).map(|t| u64_at(t, 0)));
+    if c.tag_pos.is_some() {
+        (0..n as usize).for_each(|i| c.note_tag(tp + 8 * i));
+    }
     let first = c.node_tags.len() - n as usize;
     let stride = 8 * (3 + extra);
     let cp = p.pos;
@@ -1340,6 +1403,7 @@ fn nodes22_ascii(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
         p.entry_end(&|| format!("the coordinates of node {tag}"))?;
         check_finite(p, at, tag, [x, y, z])?;
         c.node_tags.push(tag);
+        c.note_tag(p.pos);
         c.data.vertices.push([x, y, z]);
     }
     Ok(())
@@ -1398,6 +1462,7 @@ fn parametric_nodes22(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
         })?;
         check_finite(p, cp, tag as u64, x)?;
         c.node_tags.push(tag as u64);
+        c.note_tag(if p.binary { tp } else { p.pos });
         c.data.vertices.push(x);
         c.model.node_entity.push(Some((dim as u8, entity)));
         c.model.push_param(parametric(params, u));
@@ -1422,6 +1487,7 @@ fn nodes22_binary(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
         let x = [f64_at(v, 4), f64_at(v, 12), f64_at(v, 20)];
         check_finite(p, pos, tag as u64, x)?;
         c.node_tags.push(tag as u64);
+        c.note_tag(pos);
         c.data.vertices.push(x);
     }
     Ok(())
