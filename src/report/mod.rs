@@ -199,7 +199,7 @@ fn overview(doc: &mut Document, results: &Results) {
     rules.sort_unstable();
     rules.dedup();
     doc.para(format!(
-        "Rule: {} (which pairs of triangles may be merged; `--min-eta`, `--allow-invalid`).",
+        "Rule: {} (which pairs of triangles may be merged: set by --min-eta and --allow-invalid).",
         rules.join("; ")
     ));
     if let Some(m) = &results.manifest {

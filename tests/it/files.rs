@@ -433,10 +433,10 @@ fn report_and_merge_refuse_records_no_run_can_have() {
             "runs.jsonl:1".into(),
         ),
         (
-            "worst_eta Some(0.0) is not the eta of one of its",
+            "worst_eta Some(1.5) is not the eta of one of its",
             {
                 let mut l = good.clone();
-                l[1] = edit_line(&l[1], |v| v["worst_eta"] = 0.0.into());
+                l[1] = edit_line(&l[1], |v| v["worst_eta"] = 1.5.into());
                 l
             },
             "line 2".into(),
