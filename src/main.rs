@@ -25,7 +25,8 @@ fn main() -> ExitCode {
 /// joins when that variable is unset (cron, Slurm, containers, CI), on a run that then
 /// succeeds. The layer only reorders devices, which `gpu::adapters` ranks itself, so it is
 /// disabled in that case through its own switch, `NODEVICE_SELECT=1` (a user's own setting
-/// of either variable is left alone). The crate's one `unsafe`: setting the environment.
+/// of either variable is left alone). Setting the environment is `unsafe` (no thread may
+/// read it meanwhile): done first thing, before any thread exists.
 #[allow(unsafe_code)]
 fn quiet_mesa_device_select() {
     let runtime_dir_ok =

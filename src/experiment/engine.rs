@@ -128,17 +128,6 @@ pub fn check_records(
             });
         };
         let mesh = &manifest.spec.meshes[job.mesh];
-        if r.rule() != manifest.spec.rule() {
-            return Err(ExperimentError::Mismatch {
-                dir: path.to_path_buf(),
-                message: format!(
-                    "{}:{line}: run {key} was made under the rule {}, this sweep's is {}",
-                    runs.display(),
-                    r.rule(),
-                    manifest.spec.rule()
-                ),
-            });
-        }
         if (seeds && r.seed != job.seed)
             || r.mesh_hash != mesh.hash
             || r.triangles != mesh.triangles
@@ -158,6 +147,17 @@ pub fn check_records(
                 message: format!("line {line}: run {key}: {why}"),
             }
         })?;
+        if r.rule() != manifest.spec.rule() {
+            return Err(ExperimentError::Mismatch {
+                dir: path.to_path_buf(),
+                message: format!(
+                    "{}:{line}: run {key} was made under the rule {}, this sweep's is {}",
+                    runs.display(),
+                    r.rule(),
+                    manifest.spec.rule()
+                ),
+            });
+        }
         if let Some(first) = seen.insert(key.clone(), line) {
             return Err(ExperimentError::Corrupt {
                 path: runs,
@@ -187,6 +187,12 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
         if !v.is_finite() || v < 0.0 {
             return Err(format!("{name} {v} is not a finite non-negative number"));
         }
+    }
+    if let Err(e) = crate::quality::Rule::new(r.min_eta, r.allow_invalid) {
+        return Err(format!(
+            "its rule (min_eta {}, allow_invalid {}): {e}",
+            r.min_eta, r.allow_invalid
+        ));
     }
     if !super::record::ALGO_NAMES.contains(&r.algo.as_str()) {
         return Err(format!("unknown algorithm {:?}", r.algo));

@@ -244,6 +244,11 @@ impl Manifest {
             ))
         } else if m.optimum.len() > s.meshes.len() {
             Some("more optimum entries than meshes".to_string())
+        } else if let Err(e) = crate::quality::Rule::new(s.min_eta, s.allow_invalid) {
+            Some(format!(
+                "its rule (min_eta {}, allow_invalid {}): {e}",
+                s.min_eta, s.allow_invalid
+            ))
         } else {
             None
         };

@@ -433,6 +433,15 @@ fn report_and_merge_refuse_records_no_run_can_have() {
             "runs.jsonl:1".into(),
         ),
         (
+            "its rule (min_eta 2, allow_invalid false)",
+            {
+                let mut l = good.clone();
+                l[2] = edit_line(&l[2], |v| v["min_eta"] = 2.0.into());
+                l
+            },
+            "line 3".into(),
+        ),
+        (
             "worst_eta Some(1.5) is not the eta of one of its",
             {
                 let mut l = good.clone();
