@@ -224,7 +224,12 @@ pub fn write_mesh_output(
     let vtu = output_kind(path) == Some(true);
     quadrecomb::output::write_atomic(path, |mut w| {
         if vtu {
-            quadrecomb::mesh::vtu::write_to(&mut w, mesh, rec)
+            quadrecomb::mesh::vtu::write_to(
+                &mut w,
+                mesh,
+                rec,
+                quadrecomb::mesh::vtu::Encoding::Binary,
+            )
         } else {
             quadrecomb::mesh::msh::write_to(&mut w, mesh, rec)
         }

@@ -42,6 +42,23 @@ pub fn gmsh_available() -> bool {
     ok
 }
 
+/// Whether python3 can import `module` (a reader we check our files with, e.g. `vtk` or
+/// `meshio`). In CI it must be there (scripts/test-all.sh installs it), so that no check is
+/// skipped silently; elsewhere a missing module skips the check with a message.
+pub fn python_module_available(module: &str) -> bool {
+    let ok = Command::new("python3")
+        .args(["-c", &format!("import {module}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok && std::env::var_os("CI").is_some() {
+        panic!("the Python module {module} is required in CI (pip install {module})");
+    }
+    if !ok {
+        eprintln!("skipping a check: python3 cannot import {module}");
+    }
+    ok
+}
+
 /// Runs `python3 -c script args...` and returns its standard output; panics with its
 /// standard error if it fails.
 pub fn python(script: &str, args: &[&Path]) -> String {
