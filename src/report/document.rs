@@ -141,7 +141,8 @@ impl Document {
         out
     }
 
-    /// A self-contained HTML page with the figures' SVG inlined.
+    /// An HTML page with the figures' SVG inlined, except those over [`INLINE_MAX`] bytes (mesh
+    /// pictures), which it shows from their files under `figures/` beside it.
     pub fn to_html(&self, title: &str) -> String {
         let mut out = String::new();
         out.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
@@ -182,6 +183,19 @@ impl Document {
                     }
                     out.push_str("</tbody>\n</table>\n");
                 }
+                Block::Figure { file, svg, caption } if svg.len() > INLINE_MAX => {
+                    // A large picture (a mesh of thousands of elements) stays in its file
+                    // beside the page, so that the page itself loads at once.
+                    out.push_str(&format!(
+                        "<figure>\n<a href=\"{0}\"><img src=\"{0}\" loading=\"lazy\" \
+                         style=\"max-width:100%;height:auto\" alt=\"{1}\"></a>\n\
+                         <figcaption>{1} (Picture {0}, {2:.1} MB, linked rather than inlined.)\
+                         </figcaption>\n</figure>\n",
+                        escape(file),
+                        escape(caption),
+                        svg.len() as f64 / 1e6
+                    ));
+                }
                 Block::Figure { svg, caption, .. } => {
                     out.push_str("<figure>\n");
                     out.push_str(strip_xml_declaration(svg));
@@ -196,6 +210,10 @@ impl Document {
         out
     }
 }
+
+/// The largest figure inlined in the HTML page, in bytes: box plots (tens of kB) are, mesh
+/// pictures (megabytes) are linked.
+pub const INLINE_MAX: usize = 256 * 1024;
 
 /// Plain text as Markdown that shows it as it is: every character Markdown or HTML could
 /// read as markup (emphasis, code, links, images, raw HTML, entities, table cells, headings)
@@ -259,6 +277,18 @@ pub fn escape(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn large_pictures_are_linked_and_plots_inlined() {
+        let mut doc = Document::default();
+        let svg = |n: usize| format!("<svg>{}</svg>", "<g/>".repeat(n));
+        doc.figure("figures/plot.svg".into(), svg(10), "a plot".into());
+        doc.figure("figures/mesh.svg".into(), svg(INLINE_MAX), "a mesh".into());
+        let html = doc.to_html("t");
+        assert_eq!(html.matches("<svg>").count(), 1);
+        assert!(html.contains(r#"<img src="figures/mesh.svg""#), "{html}");
+        assert!(html.len() < 4096, "{} bytes", html.len());
+    }
 
     #[test]
     fn md_escape_leaves_no_markup() {

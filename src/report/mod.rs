@@ -1,7 +1,7 @@
 //! Reports: tables, box plots, mesh pictures and statistical comparisons from sweep results.
 //!
 //! [`write()`] reads a results directory (`runs.jsonl`, `manifest.json`) and writes `report.md`,
-//! `report.html` (figures inlined) and the figures as SVG files under `figures/`. The report
+//! `report.html` (plots inlined, mesh pictures shown from their files) and the figures as SVG files under `figures/`. The report
 //! holds, per mesh: a Table-1-style table (median quality % of optimum, recombined %, time,
 //! nodes per tree per algorithm and horizon), the paper's own numbers beside ours, Fig.-8-style
 //! box plots against horizon with the fitted branching factor, pictures of typical runs, and
@@ -95,7 +95,7 @@ impl Default for ReportOptions {
 pub struct ReportPaths {
     /// `report.md`.
     pub markdown: PathBuf,
-    /// `report.html` (self-contained).
+    /// `report.html` (plots inlined, mesh pictures shown from `figures/`).
     pub html: PathBuf,
     /// SVG figures under `figures/`.
     pub figures: Vec<PathBuf>,
@@ -688,6 +688,7 @@ fn pictures(
                     if zoom.is_some() { " (zoom)" } else { "" }
                 ),
                 zoom,
+                inset: zoom.is_none(),
                 ..picture::PictureOptions::default()
             };
             let (svg, counts) = picture::mesh_svg(t.mesh, &t.rec, &popts)?;
@@ -698,6 +699,12 @@ fn pictures(
             );
             if counts.culled > 0 {
                 caption.push_str(&format!(", {} back faces culled", counts.culled));
+            }
+            if let Some(([x0, y0, x1, y1], quads, leftover)) = counts.inset {
+                caption.push_str(&format!(
+                    "; below, the densest region magnified (x {x0:.4}..{x1:.4}, y {y0:.4}..{y1:.4}, \
+                     framed in red above: {quads} quads and {leftover} leftover triangles)"
+                ));
             }
             if let Some([x0, y0, x1, y1]) = zoom {
                 caption.push_str(&format!(", window x {x0}..{x1}, y {y0}..{y1}"));

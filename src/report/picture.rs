@@ -4,12 +4,15 @@
 //! are drawn in an orthographic view with back faces culled (closed surfaces; open ones are
 //! drawn back to front).
 //!
-//! Each quad and leftover triangle is one SVG `<polygon>` (its outline a separate polyline), so
-//! a picture of `q` visible quads and `l` visible leftovers has `q + l` polygons.
+//! Each quad and leftover triangle is one SVG `<polygon>` with its outline as the polygon's
+//! stroke, at sub-pixel coordinates (two decimals), so a picture of `q` visible quads and `l`
+//! visible leftovers has `q + l` polygons (plus those of the inset, when there is one). Axes,
+//! caption and colour bar are drawn by plotters; the faces are written after them in one group.
 
 use super::ReportError;
 use super::plots::plot_err;
 use crate::mesh::{Mesh, Recombined};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// Colour of leftover (unrecombined) triangles.
@@ -25,6 +28,9 @@ pub struct PictureOptions {
     pub zoom: Option<[f64; 4]>,
     /// Width of the mesh drawing in pixels (the colour bar is added to it).
     pub width: u32,
+    /// Add a magnified inset of the densest region below the picture (its window marked on
+    /// the picture), where the smallest elements are; ignored with a zoom.
+    pub inset: bool,
 }
 
 impl Default for PictureOptions {
@@ -33,12 +39,13 @@ impl Default for PictureOptions {
             title: String::new(),
             zoom: None,
             width: 720,
+            inset: false,
         }
     }
 }
 
 /// What a picture shows, for captions and tests.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PictureCounts {
     /// Quads drawn.
     pub quads: usize,
@@ -46,6 +53,8 @@ pub struct PictureCounts {
     pub leftover: usize,
     /// Faces culled as back-facing.
     pub culled: usize,
+    /// The inset's window `[x0, y0, x1, y1]` and the quads and leftovers drawn in it.
+    pub inset: Option<([f64; 4], usize, usize)>,
 }
 
 /// The viridis colour of `t` in `[0, 1]` (piecewise linear between nine reference colours).
@@ -196,6 +205,7 @@ pub fn mesh_svg(
         quads: 0,
         leftover: 0,
         culled: 0,
+        inset: None,
     };
     let mut add = |pts: Vec<[f64; 3]>, color: RGBColor, leftover: bool| {
         let (depth, back) = view.depth_and_back(&pts);
@@ -242,72 +252,218 @@ pub fn mesh_svg(
             w
         }
     };
-    // Clip every face to the window (plotters does not clip) and drop what falls outside or
-    // only touches the window's border (a clipped polygon of zero area).
-    let min_area = 1e-12 * (window[2] - window[0]).abs() * (window[3] - window[1]).abs();
-    let mut drawn: Vec<Face> = faces
-        .into_iter()
-        .filter_map(|mut f| {
-            f.points = clip_to_window(&f.points, window);
-            (f.points.len() >= 3 && polygon_area(&f.points) > min_area).then_some(f)
-        })
-        .collect();
-    drawn.sort_by(|a, b| a.depth.total_cmp(&b.depth));
+    let drawn = clip_faces(&faces, window);
     counts.quads = drawn.iter().filter(|f| !f.leftover).count();
     counts.leftover = drawn.iter().filter(|f| f.leftover).count();
+    let inset = (opts.inset && opts.zoom.is_none())
+        .then(|| densest_window(&drawn, window))
+        .flatten();
+    let inset_faces = inset.map(|w| clip_faces(&faces, w));
+    if let (Some(w), Some(f)) = (inset, &inset_faces) {
+        let quads = f.iter().filter(|f| !f.leftover).count();
+        counts.inset = Some((w, quads, f.len() - quads));
+    }
 
-    let (dx, dy) = (
-        (window[2] - window[0]).max(1e-300),
-        (window[3] - window[1]).max(1e-300),
-    );
-    const Y_LABELS: u32 = 64;
-    const X_LABELS: u32 = 36;
-    const CAPTION: u32 = 34;
-    const BAR: u32 = 110;
+    const Y_LABELS: u32 = 72;
+    const X_LABELS: u32 = 44;
+    const CAPTION: u32 = 38;
+    const BAR: u32 = 120;
     let plot_w = opts.width.max(200) - Y_LABELS - 20;
-    let plot_h = ((plot_w as f64 * dy / dx).round() as u32).clamp(120, 4 * plot_w);
-    let height = plot_h + X_LABELS + CAPTION + 20;
+    let aspect = |w: [f64; 4]| (w[3] - w[1]).max(1e-300) / (w[2] - w[0]).max(1e-300);
+    let plot_h = ((plot_w as f64 * aspect(window)).round() as u32).clamp(120, 4 * plot_w);
+    let main_h = plot_h + X_LABELS + CAPTION + 20;
+    let inset_h = inset.map_or(0, |w| {
+        ((plot_w as f64 * aspect(w)).round() as u32).clamp(120, 4 * plot_w)
+            + X_LABELS
+            + CAPTION
+            + 20
+    });
+    let height = main_h + inset_h;
     let width = opts.width.max(200) + BAR;
 
     let mut svg = String::new();
+    // Pixel mappings of the panels, known once plotters has laid them out.
+    let mut panels: Vec<(Mapping, &[Face])> = Vec::new();
     {
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
-        let (left, right) = root.split_horizontally(width - BAR);
-        let mut chart = ChartBuilder::on(&left)
-            .caption(&opts.title, ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(X_LABELS)
-            .y_label_area_size(Y_LABELS)
-            .build_cartesian_2d(window[0]..window[2], window[1]..window[3])
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_labels(6)
-            .y_labels(6)
-            .x_desc(if view.planar { "x" } else { "view x" })
-            .y_desc(if view.planar { "y" } else { "view y" })
-            .draw()
-            .map_err(plot_err)?;
-        let edge = RGBColor(30, 30, 30).stroke_width(1);
-        for f in &drawn {
-            chart
-                .draw_series(std::iter::once(Polygon::new(
-                    f.points.clone(),
-                    f.color.filled(),
-                )))
+        let (pictures, bar) = root.split_horizontally(width - BAR);
+        let (main, below) = pictures.split_vertically(main_h);
+        let frame = |area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+                     title: &str,
+                     w: [f64; 4]|
+         -> Result<Mapping, ReportError> {
+            let chart = ChartBuilder::on(area)
+                .caption(title, ("sans-serif", 22))
+                .margin(10)
+                .x_label_area_size(X_LABELS)
+                .y_label_area_size(Y_LABELS)
+                .build_cartesian_2d(w[0]..w[2], w[1]..w[3])
                 .map_err(plot_err)?;
-            let mut outline = f.points.clone();
-            outline.push(f.points[0]);
+            let mut chart = chart;
             chart
-                .draw_series(std::iter::once(PathElement::new(outline, edge)))
+                .configure_mesh()
+                .disable_mesh()
+                .x_labels(6)
+                .y_labels(6)
+                .label_style(("sans-serif", 17))
+                .axis_desc_style(("sans-serif", 18))
+                .x_desc(if view.planar { "x" } else { "view x" })
+                .y_desc(if view.planar { "y" } else { "view y" })
+                .draw()
                 .map_err(plot_err)?;
+            Ok(Mapping::of(&chart, w))
+        };
+        let main_map = frame(&main, &opts.title, window)?;
+        if let Some(w) = inset {
+            let title = format!("{} (inset: the densest region)", opts.title);
+            let inset_map = frame(&below, title.trim_start(), w)?;
+            panels.push((main_map, &drawn));
+            panels.push((inset_map, inset_faces.as_deref().unwrap_or(&[])));
+        } else {
+            panels.push((main_map, &drawn));
         }
-        draw_colour_bar(&right, height)?;
+        draw_colour_bar(&bar, main_h)?;
         root.present().map_err(plot_err)?;
     }
+    let mut faces_svg = String::new();
+    for (map, faces) in &panels {
+        write_faces(&mut faces_svg, map, faces);
+    }
+    // The inset's window, framed on the picture above its faces.
+    if let (Some(w), Some((map, _))) = (inset, panels.first()) {
+        let (a, b) = (map.pixel((w[0], w[3])), map.pixel((w[2], w[1])));
+        faces_svg.push_str(&format!(
+            r##"<rect x="{:.2}" y="{:.2}" width="{:.2}" height="{:.2}" fill="none" stroke="#E61E1E" stroke-width="2"/>"##,
+            a.0.min(b.0),
+            a.1.min(b.1),
+            (b.0 - a.0).abs(),
+            (b.1 - a.1).abs()
+        ));
+    }
+    let end = svg.rfind("</svg>").unwrap_or(svg.len());
+    svg.insert_str(end, &faces_svg);
     Ok((svg, counts))
+}
+
+/// The faces of `faces` clipped to `window` (plotters does not clip), without those that fall
+/// outside or only touch the window's border (a clipped polygon of zero area), back to front.
+fn clip_faces(faces: &[Face], window: [f64; 4]) -> Vec<Face> {
+    let min_area = 1e-12 * (window[2] - window[0]).abs() * (window[3] - window[1]).abs();
+    let mut drawn: Vec<Face> = faces
+        .iter()
+        .filter_map(|f| {
+            let points = clip_to_window(&f.points, window);
+            (points.len() >= 3 && polygon_area(&points) > min_area).then_some(Face {
+                points,
+                depth: f.depth,
+                color: f.color,
+                leftover: f.leftover,
+            })
+        })
+        .collect();
+    drawn.sort_by(|a, b| a.depth.total_cmp(&b.depth));
+    drawn
+}
+
+/// The window of the inset: a box of a sixth of the picture's width (half as high), centred
+/// on the cell of a 24 x 24 grid over `window` that holds the most face centroids, and kept
+/// inside `window`. `None` when there is nothing to magnify (fewer than 200 faces).
+fn densest_window(faces: &[Face], window: [f64; 4]) -> Option<[f64; 4]> {
+    const GRID: usize = 24;
+    if faces.len() < 200 {
+        return None;
+    }
+    let (dx, dy) = (window[2] - window[0], window[3] - window[1]);
+    if dx <= 0.0 || dy <= 0.0 {
+        return None;
+    }
+    let mut count = vec![0u32; GRID * GRID];
+    let cell = |v: f64, lo: f64, d: f64| (((v - lo) / d * GRID as f64) as usize).min(GRID - 1);
+    for f in faces {
+        let n = f.points.len() as f64;
+        let cx = f.points.iter().map(|p| p.0).sum::<f64>() / n;
+        let cy = f.points.iter().map(|p| p.1).sum::<f64>() / n;
+        count[cell(cy, window[1], dy) * GRID + cell(cx, window[0], dx)] += 1;
+    }
+    // The first densest cell in row-major order, for a deterministic choice.
+    let best = (0..count.len()).max_by_key(|&i| (count[i], std::cmp::Reverse(i)))?;
+    let centre = (
+        window[0] + ((best % GRID) as f64 + 0.5) * dx / GRID as f64,
+        window[1] + ((best / GRID) as f64 + 0.5) * dy / GRID as f64,
+    );
+    let (w, h) = ((dx / 6.0).min(dx), (dx / 12.0).min(dy));
+    let x0 = (centre.0 - w / 2.0).clamp(window[0], window[2] - w);
+    let y0 = (centre.1 - h / 2.0).clamp(window[1], window[3] - h);
+    Some([x0, y0, x0 + w, y0 + h])
+}
+
+/// How picture coordinates map to the SVG's pixels in one panel: linearly, through the pixels
+/// plotters gives the window's corners.
+struct Mapping {
+    origin: (f64, f64),
+    scale: (f64, f64),
+    window: [f64; 4],
+}
+
+impl Mapping {
+    fn of<DB: DrawingBackend>(
+        chart: &ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+        w: [f64; 4],
+    ) -> Mapping {
+        let (a, b) = (
+            chart.backend_coord(&(w[0], w[1])),
+            chart.backend_coord(&(w[2], w[3])),
+        );
+        let span = |p: i32, q: i32, d: f64| (q - p) as f64 / d.max(1e-300);
+        Mapping {
+            origin: (a.0 as f64, a.1 as f64),
+            scale: (span(a.0, b.0, w[2] - w[0]), span(a.1, b.1, w[3] - w[1])),
+            window: w,
+        }
+    }
+
+    fn pixel(&self, p: (f64, f64)) -> (f64, f64) {
+        (
+            self.origin.0 + (p.0 - self.window[0]) * self.scale.0,
+            self.origin.1 + (p.1 - self.window[1]) * self.scale.1,
+        )
+    }
+}
+
+/// Appends the faces as one SVG group of polygons at sub-pixel coordinates, outlined thinner
+/// when the faces are small on screen, so that their colour still shows.
+fn write_faces(out: &mut String, map: &Mapping, faces: &[Face]) {
+    use std::fmt::Write as _;
+    let mut sizes: Vec<f64> = faces
+        .iter()
+        .map(|f| polygon_area(&f.points) * (map.scale.0 * map.scale.1).abs())
+        .collect();
+    sizes.sort_by(f64::total_cmp);
+    let typical = sizes.get(sizes.len() / 2).map_or(10.0, |a| a.sqrt());
+    let stroke = (typical / 12.0).clamp(0.1, 1.0);
+    let _ = write!(
+        out,
+        r##"<g stroke="#1E1E1E" stroke-width="{stroke:.2}" stroke-linejoin="round">"##
+    );
+    for f in faces {
+        let points: Vec<String> = (f.points.iter())
+            .map(|&p| {
+                let (x, y) = map.pixel(p);
+                format!("{x:.2},{y:.2}")
+            })
+            .collect();
+        let c = f.color;
+        let _ = write!(
+            out,
+            r##"<polygon points="{}" fill="#{:02X}{:02X}{:02X}"/>"##,
+            points.join(" "),
+            c.0,
+            c.1,
+            c.2
+        );
+    }
+    out.push_str("</g>\n");
 }
 
 /// The eta colour bar and the leftover legend, in their own drawing area.
@@ -331,7 +487,7 @@ fn draw_colour_bar(
         BLACK.stroke_width(1),
     ))
     .map_err(plot_err)?;
-    let font = ("sans-serif", 12).into_font();
+    let font = ("sans-serif", 17).into_font();
     for k in 0..=4 {
         let v = k as f64 / 4.0;
         let y = bottom - (bottom - top) * k / 4;

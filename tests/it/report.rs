@@ -611,6 +611,53 @@ fn planar_picture_draws_every_quad_and_leftover() {
     parse_and_render(&svg);
 }
 
+/// The whole-mesh picture of a graded mesh: faces at sub-pixel coordinates, and an inset of
+/// the densest region (borouchaki's: beside the hole, where the elements are smallest) drawn
+/// below with its own faces and framed on the picture.
+#[test]
+fn picture_has_sub_pixel_faces_and_an_inset_of_the_densest_region() {
+    let mesh = quadrecomb::mesh::load("borouchaki").unwrap();
+    let table = CandidateTable::build(&mesh);
+    let out = quadrecomb::search::run(&mesh, &table, quadrecomb::search::Algo::Greedy, SEED);
+    let rec = recombined(&mesh, &table, &out.chosen);
+    let opts = PictureOptions {
+        inset: true,
+        ..PictureOptions::default()
+    };
+    let (svg, counts) = mesh_svg(&mesh, &rec, &opts).unwrap();
+    assert_eq!(counts.quads, rec.quads.len());
+    let ([x0, y0, x1, y1], q, l) = counts.inset.expect("an inset");
+    assert!(q > 100, "{q} quads in the inset");
+    assert_eq!(polygons(&svg), counts.quads + counts.leftover + q + l);
+    // Inside the unit square, its centre within 0.25 of the hole's (0.6, 0.75).
+    assert!(0.0 <= x0 && x0 < x1 && x1 <= 1.0 && 0.0 <= y0 && y0 < y1 && y1 <= 1.0);
+    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+    assert!(
+        ((cx - 0.6).powi(2) + (cy - 0.75).powi(2)).sqrt() < 0.25,
+        "inset at ({cx}, {cy})"
+    );
+    // Coordinates with two decimals, not whole pixels: most vertices are off the pixel grid.
+    let coords: Vec<&str> = svg
+        .split("<polygon points=\"")
+        .skip(1)
+        .flat_map(|p| p[..p.find('"').unwrap()].split([' ', ',']))
+        .collect();
+    let fractional = coords.iter().filter(|c| !c.ends_with(".00")).count();
+    assert!(
+        fractional * 2 > coords.len(),
+        "{fractional} of {} coordinates off the pixel grid",
+        coords.len()
+    );
+    assert!(
+        svg.contains(r##"fill="none" stroke="#E61E1E""##),
+        "inset not framed"
+    );
+    parse_and_render(&svg);
+    // Without the option (and with a zoom) there is no inset.
+    let (_, plain) = mesh_svg(&mesh, &rec, &PictureOptions::default()).unwrap();
+    assert_eq!(plain.inset, None);
+}
+
 #[test]
 fn closed_surface_picture_culls_back_faces() {
     // Octahedron: from the picture's view direction (1, -1.4, 1.1) four faces face the viewer.
