@@ -429,10 +429,12 @@ fn element_table(doc: &mut Document, configs: &[(&Config, &[Run])]) {
 fn family_blocks(doc: &mut Document, families: &[Family]) {
     for f in families {
         doc.para(f.summary());
-        doc.table(
-            significance::header(),
-            f.pairs.iter().map(|p| p.row()).collect(),
-        );
+        if !f.pairs.is_empty() {
+            doc.table(
+                significance::header(),
+                f.pairs.iter().map(|p| p.row()).collect(),
+            );
+        }
     }
 }
 

@@ -123,28 +123,77 @@ fn direction(m: Metric, a: f64) -> &'static str {
     }
 }
 
+/// A difference shown as it is, without a test: a test needs a sample on each side.
+#[derive(Debug, Clone)]
+pub struct Untested {
+    /// Label of the first side.
+    pub first: String,
+    /// Label of the second side.
+    pub second: String,
+    /// The medians of both sides.
+    pub median: [f64; 2],
+    /// Why it is not tested.
+    pub why: &'static str,
+}
+
+/// Why a comparison of samples `x` and `y` of `metric` cannot be tested, if it cannot: two
+/// single runs (two deterministic configurations: their difference is exact, there is nothing
+/// to test), or a single timing on either side (one measurement on a loaded machine is no
+/// exact value to test a sample against).
+fn untestable(metric: Metric, x: usize, y: usize) -> Option<&'static str> {
+    if x <= 1 && y <= 1 {
+        Some("one run on each side, so the difference is exact and there is nothing to test")
+    } else if metric == Metric::Time && (x <= 1 || y <= 1) {
+        Some("one timing on one side, which is no exact value to test a sample of times against")
+    } else {
+        None
+    }
+}
+
 /// A family of comparisons, Holm-corrected together.
 #[derive(Debug, Clone)]
 pub struct Family {
     /// What the family asks (e.g. "consecutive horizons, quality").
     pub title: String,
-    /// The comparisons.
+    /// The measure compared.
+    pub metric: Metric,
+    /// The comparisons tested (and corrected together).
     pub pairs: Vec<Pair>,
+    /// Differences shown without a test, outside the Holm family.
+    pub untested: Vec<Untested>,
 }
 
 impl Family {
     /// Builds a family from `(first label, first runs, second label, second runs)` and applies
-    /// Holm's correction. The bootstrap of comparison `i` is seeded with `seed + i`.
+    /// Holm's correction to the comparisons that can be tested (see [`Untested`]). The
+    /// bootstrap of comparison `i` (counting all sides) is seeded with `seed + i`.
     pub fn build(
         title: String,
         metric: Metric,
         sides: Vec<(String, &[Run], String, &[Run])>,
         seed: u64,
     ) -> Family {
+        let mut untested = Vec::new();
+        let mut kept = Vec::new();
+        for (i, (first, x, second, y)) in sides.into_iter().enumerate() {
+            match untestable(metric, x.len(), y.len()) {
+                Some(why) => untested.push(Untested {
+                    median: [
+                        crate::stats::describe::median(&metric.values(x)),
+                        crate::stats::describe::median(&metric.values(y)),
+                    ],
+                    first,
+                    second,
+                    why,
+                }),
+                None => kept.push((i, (first, x, second, y))),
+            }
+        }
+        let (index, sides): (Vec<usize>, Vec<_>) = kept.into_iter().unzip();
         let mut cmps: Vec<Comparison> = sides
             .iter()
-            .enumerate()
-            .map(|(i, (_, x, _, y))| {
+            .zip(&index)
+            .map(|((_, x, _, y), &i)| {
                 compare(
                     &metric.values(x),
                     &metric.values(y),
@@ -164,13 +213,39 @@ impl Family {
                 cmp,
             })
             .collect();
-        Family { title, pairs }
+        Family {
+            title,
+            metric,
+            pairs,
+            untested,
+        }
     }
 
-    /// A summary sentence: how many differences are significant, and which.
+    /// A summary sentence: how many differences are significant, and which; then the
+    /// differences not tested, as they are.
     pub fn summary(&self) -> String {
+        let mut out = self.tested_summary();
+        for u in &self.untested {
+            let m = self.metric;
+            out.push_str(&format!(
+                " Not tested: {} vs {}, median {} vs {} (difference {}): {}.",
+                u.first,
+                u.second,
+                fmt_metric(m, u.median[0], false),
+                fmt_metric(m, u.median[1], false),
+                fmt_metric(m, u.median[0] - u.median[1], true),
+                u.why
+            ));
+        }
+        out
+    }
+
+    fn tested_summary(&self) -> String {
         let sig: Vec<&Pair> = self.pairs.iter().filter(|p| p.significant()).collect();
         let n = self.pairs.len();
+        if n == 0 {
+            return format!("{}: no difference to test.", self.title);
+        }
         if sig.is_empty() {
             return format!(
                 "{}: none of the {n} differences is significant at {ALPHA} after Holm's correction.",

@@ -262,6 +262,71 @@ fn record(
     .to_json_line()
 }
 
+/// Two deterministic single runs are compared as they are, outside the Holm family; a sample
+/// of times is not tested against one timing; a sample of qualities is (against an exact
+/// deterministic value), and the tested comparisons keep their bootstrap seeds.
+#[test]
+fn single_runs_are_shown_as_differences_not_tests() {
+    use quadrecomb::report::Metric;
+    use quadrecomb::report::significance::Family;
+    let runs = |algo: &str, h: Option<u32>, n: u32, q: f64, t: f64| -> Vec<RunRecord> {
+        (0..n)
+            .map(|i| {
+                let line = record(
+                    "sphere",
+                    algo,
+                    h,
+                    i,
+                    q + f64::from(i) * 0.01,
+                    90.0,
+                    t * (1.0 + f64::from(i) * 0.01),
+                );
+                serde_json::from_str(&line).unwrap()
+            })
+            .collect()
+    };
+    let greedy = runs("greedy", None, 1, 87.0, 0.02);
+    let uniform1 = runs("uniform", Some(1), 1, 87.5, 0.03);
+    let selective = runs("selective", Some(2), 30, 90.0, 0.05);
+    let family = |metric| {
+        Family::build(
+            "t".into(),
+            metric,
+            vec![
+                (
+                    "uniform h=1".into(),
+                    &uniform1[..],
+                    "greedy".into(),
+                    &greedy[..],
+                ),
+                (
+                    "selective h=2".into(),
+                    &selective[..],
+                    "greedy".into(),
+                    &greedy[..],
+                ),
+            ],
+            SEED,
+        )
+    };
+    let q = family(Metric::Quality);
+    assert_eq!(q.pairs.len(), 1, "only the sample against greedy is tested");
+    assert_eq!(q.pairs[0].first, "selective h=2");
+    assert_eq!(q.untested.len(), 1);
+    let text = q.summary();
+    assert!(text.contains("Not tested: uniform h=1 vs greedy"), "{text}");
+    assert!(text.contains("one run on each side"), "{text}");
+    assert!(!text.contains("U = 1"), "{text}");
+    let t = family(Metric::Time);
+    assert!(t.pairs.is_empty(), "times tested against one timing");
+    assert_eq!(t.untested.len(), 2);
+    assert!(
+        t.summary().contains("one timing on one side"),
+        "{}",
+        t.summary()
+    );
+}
+
 /// Writes `runs.jsonl` for mesh "sphere": quality rises with the selective horizon, uniform h=2
 /// is worse and much slower, like the paper's Table 1; `shift` moves every quality.
 fn synthetic_dir(dir: &Path, runs: u32, seed: u64, shift: f64) {
