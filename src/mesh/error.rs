@@ -70,7 +70,8 @@ pub enum ReadError {
         source: std::io::Error,
     },
     #[error(
-        "{path}: unknown mesh format (expected a Gmsh .msh file, version 2.2 or 4.1, ASCII or binary, or a built-in name: {builtins})"
+        "{path}: unknown mesh format (expected a Gmsh .msh file, version 2.2 or 4.1, ASCII or binary, or a built-in name: {builtins}){hint}",
+        hint = conversion_hint(.path)
     )]
     UnknownFormat { path: PathBuf, builtins: String },
     #[error("{path}:{line}: {message}")]
@@ -94,4 +95,45 @@ fn flatness(lg: f64) -> String {
             lg.round()
         )
     }
+}
+
+/// How to turn a mesh of another format into a `.msh` quadrecomb reads, naming the tools (Gmsh,
+/// meshio) and the exact command for this file.
+fn conversion_hint(path: &std::path::Path) -> String {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let what = match ext.as_str() {
+        "stl" => "an STL triangulation",
+        "vtk" | "vtu" | "vtp" => "a VTK file",
+        "obj" => "a Wavefront OBJ file",
+        "mesh" | "meshb" => "a Medit mesh",
+        "ply" => "a PLY file",
+        "off" => "an OFF file",
+        "inp" => "an Abaqus input file",
+        "med" => "a MED file",
+        "unv" => "an I-DEAS universal file",
+        "bdf" | "nas" => "a Nastran file",
+        "cgns" => "a CGNS file",
+        "su2" => "an SU2 mesh",
+        _ => "",
+    };
+    if ext == "msh" {
+        // Named .msh but not Gmsh's (ANSYS Fluent also uses .msh): no conversion to name.
+        return "; the file does not begin with $MeshFormat (an ANSYS Fluent .msh is not \
+                Gmsh's: convert it with `meshio convert FILE out.msh --output-format gmsh`)"
+            .to_string();
+    }
+    let out = path.with_extension("msh");
+    let (p, o) = (path.display(), out.display());
+    let lead = if what.is_empty() {
+        "if it is a mesh in another format".to_string()
+    } else {
+        format!("this looks like {what}")
+    };
+    format!(
+        "; {lead}: convert it to .msh with Gmsh (`gmsh {p} -0 -format msh41 -o {o}`) or \
+         meshio (`pip install meshio; meshio convert {p} {o} --output-format gmsh`)"
+    )
 }

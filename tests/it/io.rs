@@ -453,6 +453,57 @@ print(json.dumps({
     );
 }
 
+/// A mesh in another format gets an error that says how to convert it, and the commands it
+/// names (Gmsh's and meshio's, run where their command-line tools are installed) make a `.msh`
+/// that quadrecomb reads.
+#[test]
+fn other_formats_get_a_conversion_command_that_works() {
+    let dir = tempfile::tempdir().unwrap();
+    let files = [
+        (
+            "tri.stl",
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n",
+        ),
+        ("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+    ];
+    for (name, text) in files {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = run_in(dir.path(), &["info", name]);
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(err.contains("unknown mesh format"), "{err}");
+        // Each suggested command, between backticks, run as written.
+        let commands: Vec<&str> = err.split('`').skip(1).step_by(2).collect();
+        assert_eq!(commands.len(), 2, "{err}");
+        assert!(commands[0].starts_with("gmsh ") && commands[1].contains("meshio convert"));
+        for command in commands {
+            let command = command.trim_start_matches("pip install meshio; ");
+            let words: Vec<&str> = command.split_whitespace().collect();
+            let msh = dir.path().join("tri.msh");
+            let _ = std::fs::remove_file(&msh);
+            match Command::new(words[0])
+                .args(&words[1..])
+                .current_dir(dir.path())
+                .output()
+            {
+                Ok(o) if o.status.success() => {
+                    let info = run_in(dir.path(), &["info", "tri.msh", "--json"]);
+                    assert!(
+                        info.status.success(),
+                        "{command}: {}",
+                        String::from_utf8_lossy(&info.stderr)
+                    );
+                    let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+                    assert_eq!(v["triangles"], 1, "{command}");
+                }
+                Ok(o) => panic!("{command} failed: {}", String::from_utf8_lossy(&o.stderr)),
+                Err(_) => eprintln!("skipping `{command}`: {} is not installed", words[0]),
+            }
+        }
+    }
+}
+
 /// Runs `quadrecomb info path` and checks exit code 2, no panic, and that the message names
 /// the file and says each of `expect`.
 fn assert_bad(path: &Path, expect: &[&str]) -> String {
