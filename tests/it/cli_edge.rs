@@ -112,6 +112,38 @@ fn exit_4_results_directory() {
     );
 }
 
+/// The library's notices reach stderr through the command: the backend `auto` picked, once,
+/// and the resume; `-q` keeps the backend line (as before) but not the progress or resume.
+#[test]
+fn notices_reach_stderr_through_the_command() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut args = sweep_args("d");
+    args.retain(|a| !["--backend", "cpu", "-q"].contains(a));
+    args.push("--plain");
+    let first = run_in(tmp.path(), &args);
+    let err = stderr(&first);
+    assert!(first.status.success(), "{err}");
+    let backend: Vec<&str> = (err.lines())
+        .filter(|l| l.starts_with("quality backend: "))
+        .collect();
+    assert_eq!(backend.len(), 1, "{err}");
+    assert!(err.contains("sweep: 1/1 runs (100.0%)"), "{err}");
+    args.push("--resume");
+    let resumed = stderr(&run_in(tmp.path(), &args));
+    assert!(
+        resumed.contains("sweep: resuming: 1 of 1 runs already recorded\n"),
+        "{resumed}"
+    );
+    args.push("-q");
+    args.retain(|a| *a != "--plain");
+    let quiet = stderr(&run_in(tmp.path(), &args));
+    assert!(quiet.starts_with("quality backend: "), "{quiet}");
+    assert!(
+        !quiet.contains("resuming") && !quiet.contains("1/1 runs"),
+        "{quiet}"
+    );
+}
+
 // 5 (out of memory) is checked by `memory::out_of_memory_is_an_error_not_an_abort`, and 130
 // (Ctrl-C) by the runner's interrupt test.
 
