@@ -5,7 +5,7 @@ mod cli;
 
 use std::process::ExitCode;
 
-/// Out of memory is an error with a message and exit code 2, not an abort.
+/// Out of memory is an error with a message and exit code 5, not an abort.
 #[global_allocator]
 static ALLOC: cli::oom::ExitOnOom = cli::oom::ExitOnOom;
 

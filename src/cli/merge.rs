@@ -20,7 +20,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let merged = merge(&args.dirs, &args.out).map_err(super::sweep::bad_input)?;
+    let merged = merge(&args.dirs, &args.out)?;
     eprintln!(
         "merge: {} runs from {} directories into {}",
         merged.records,

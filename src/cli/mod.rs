@@ -1,6 +1,7 @@
 //! Subcommands, one module each: `Args` (clap derive) and `run(args)`.
 
 mod bench;
+mod errors;
 mod generate;
 mod info;
 mod merge;
@@ -10,12 +11,12 @@ mod progress_bar;
 mod recombine;
 mod report;
 mod sweep;
+mod sweep_progress;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
-/// Exit code for bad input (unreadable or invalid mesh, bad arguments).
-pub const EXIT_BAD_INPUT: u8 = 2;
+pub use errors::{describe, exit_code};
 
 #[derive(Debug, Parser)]
 #[command(name = "quadrecomb", version, about, propagate_version = true)]
@@ -57,16 +58,6 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Report(args) => report::run(args),
         Command::Bench(args) => bench::run(args),
     }
-}
-
-/// Exit code for an error: [`EXIT_BAD_INPUT`] when the input was at fault, 1 otherwise.
-pub fn exit_code(err: &anyhow::Error) -> u8 {
-    let bad_input = err.chain().any(|e| {
-        e.is::<quadrecomb::mesh::ReadError>()
-            || e.is::<quadrecomb::mesh::MeshError>()
-            || e.is::<BadInput>()
-    });
-    if bad_input { EXIT_BAD_INPUT } else { 1 }
 }
 
 /// Which pairs may be merged: the flags of every command that recombines.
@@ -124,27 +115,12 @@ pub fn print_element_lines(
     println!("rule            {rule}");
 }
 
-/// An error in the user's arguments or input files that is not a mesh error.
+/// An error in the command line's arguments that clap does not see (a value out of range,
+/// values that contradict each other, an output path that cannot be written): a usage error,
+/// exit code 2 ([`errors::EXIT_USAGE`]).
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 pub struct BadInput(pub String);
-
-/// The error and its causes on one line, `a: b: c`, skipping a cause whose message its parent
-/// already ends with (typed errors often print their source in their own message too).
-pub fn describe(err: &anyhow::Error) -> String {
-    let mut out = String::new();
-    for cause in err.chain() {
-        let msg = cause.to_string();
-        if out.ends_with(&msg) {
-            continue;
-        }
-        if !out.is_empty() {
-            out.push_str(": ");
-        }
-        out.push_str(&msg);
-    }
-    out
-}
 
 /// Checks before any work that an output path names a `.msh` or `.vtu` file (any case) in
 /// a directory that exists, so that a long run does not end on a path it cannot write.

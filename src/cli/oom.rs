@@ -1,4 +1,4 @@
-//! Out of memory: a failed allocation ends the process with exit code 2 and a message that
+//! Out of memory: a failed allocation ends the process with exit code 5 and a message that
 //! says what was being done and how much could not be had (Rust's default is to abort:
 //! exit 134, "memory allocation of N bytes failed"). The command line names its phases
 //! ([`phase`]); the library knows nothing of this. Code that asks for memory it can do
@@ -99,7 +99,7 @@ impl Write for Message {
 }
 
 /// An allocation of `size` bytes failed: unless the caller asked to see it, say so and
-/// exit with code 2 (bad input: the mesh is too large for the memory this process may
+/// exit with code 5 (out of memory: the input is too large for the memory this process may
 /// have).
 fn failed(size: usize) {
     if FALLIBLE.try_with(Cell::get).unwrap_or(false) {
@@ -126,14 +126,14 @@ fn failed(size: usize) {
     exit_with(&m.buf[..m.len]);
 }
 
-/// Writes `msg` to stderr and ends the process with code 2, allocating nothing and running
-/// no destructor (the heap may be in use by the failed call).
+/// Writes `msg` to stderr and ends the process with code 5 (`EXIT_OUT_OF_MEMORY`), allocating
+/// nothing and running no destructor (the heap may be in use by the failed call).
 #[allow(unsafe_code)]
 fn exit_with(msg: &[u8]) -> ! {
     // SAFETY: write(2) reads `msg` for its length; _exit ends the process at once.
     unsafe {
         libc::write(2, msg.as_ptr().cast(), msg.len());
-        libc::_exit(i32::from(super::EXIT_BAD_INPUT))
+        libc::_exit(i32::from(super::errors::EXIT_OUT_OF_MEMORY))
     }
 }
 

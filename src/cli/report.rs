@@ -76,10 +76,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         picture_configs,
         seed: args.seed,
     };
-    let paths = report::write(&args.dir, &opts).map_err(|e| match e {
-        report::ReportError::Plot(_) => anyhow::Error::new(e),
-        other => anyhow::Error::new(BadInput(other.to_string())),
-    })?;
+    // Its exit code follows the error's kind (`errors::exit_code`).
+    let paths = report::write(&args.dir, &opts)?;
     println!("{}", paths.markdown.display());
     println!("{}", paths.html.display());
     for f in &paths.figures {

@@ -6,15 +6,37 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context;
 use quadrecomb::experiment::ExperimentError;
+use quadrecomb::experiment::config::{
+    ConfigError, DEFAULT_SEED, MAX_HORIZONS, MAX_RUNS, SizeError, SweepConfig, SweepRequest,
+};
 use quadrecomb::experiment::manifest::Shard;
-use quadrecomb::experiment::progress::ProgressMode;
-use quadrecomb::experiment::sweep::{self, DEFAULT_SEED, MAX_HORIZONS, SweepConfig};
+use quadrecomb::experiment::sweep;
 use quadrecomb::gpu::Backend;
 
 use super::BadInput;
+use super::errors::EXIT_INTERRUPTED;
+use super::sweep_progress::{ProgressMode, SweepDisplay};
 
-/// Exit code after Ctrl-C (128 + SIGINT, as shells report it).
-const EXIT_INTERRUPTED: u8 = 130;
+/// `--backend`: who computes the quad qualities.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum BackendArg {
+    /// A real GPU if present, else lavapipe (software Vulkan), else the CPU twin.
+    Auto,
+    /// A Vulkan adapter (the best one, lavapipe included); an error if there is none.
+    Gpu,
+    /// The CPU twin of the kernel (f32, all cores).
+    Cpu,
+}
+
+impl From<BackendArg> for Backend {
+    fn from(b: BackendArg) -> Backend {
+        match b {
+            BackendArg::Auto => Backend::Auto,
+            BackendArg::Gpu => Backend::Gpu,
+            BackendArg::Cpu => Backend::Cpu,
+        }
+    }
+}
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -41,8 +63,8 @@ pub struct Args {
     #[arg(long, default_value_t = DEFAULT_SEED)]
     seed: u64,
     /// Who computes the quad qualities.
-    #[arg(long, value_enum, default_value_t = Backend::Auto)]
-    backend: Backend,
+    #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
+    backend: BackendArg,
     #[command(flatten)]
     rule: super::RuleArgs,
     /// Results directory (default: results/<mesh> for one mesh, results/sweep otherwise;
@@ -112,7 +134,7 @@ fn parse_horizons(s: &str) -> Result<Horizons, String> {
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let paper = SweepConfig::paper();
+    let paper = SweepRequest::default();
     let meshes = if args.meshes.is_empty() {
         paper.meshes.clone()
     } else {
@@ -130,14 +152,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         };
         PathBuf::from("results").join(name)
     });
-    if out.exists() && !out.is_dir() {
-        return Err(BadInput(format!(
-            "--out {}: exists and is not a directory",
-            out.display()
-        ))
+    if let Ok(meta) = std::fs::metadata(&out)
+        && !meta.is_dir()
+    {
+        return Err(ExperimentError::NotADirectory {
+            kind: quadrecomb::mesh::file_kind(&meta).to_string(),
+            dir: out,
+        }
         .into());
     }
-    let config = SweepConfig {
+    let config = SweepConfig::new(SweepRequest {
         meshes,
         algos: if args.algos.is_empty() {
             paper.algos.clone()
@@ -149,21 +173,21 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         baseline_runs: args.baseline_runs,
         seed: args.seed,
         threads: args.threads.unwrap_or(paper.threads),
-        backend: args.backend,
+        backend: args.backend.into(),
         rule: args.rule.rule()?,
         out: out.clone(),
         resume: args.resume,
         overwrite: args.overwrite,
         shard: args.shard,
-        progress: if args.quiet {
-            ProgressMode::Quiet
-        } else if args.plain {
-            ProgressMode::Plain
-        } else {
-            ProgressMode::Auto
-        },
-    };
-    config.validate().map_err(bad_input)?;
+    })
+    .map_err(config_error)?;
+    let mut display = SweepDisplay::new(if args.quiet {
+        ProgressMode::Quiet
+    } else if args.plain {
+        ProgressMode::Plain
+    } else {
+        ProgressMode::Auto
+    });
 
     ctrlc::set_handler(|| {
         if CANCEL.swap(true, Ordering::SeqCst) {
@@ -174,7 +198,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     })
     .context("installing the Ctrl-C handler")?;
 
-    let (manifest, report) = sweep::run(&config, &CANCEL).map_err(bad_input)?;
+    let (manifest, report) = sweep::run(&config, &CANCEL, &mut |e| display.event(e))?;
     let shard = manifest
         .shard
         .map(|s| format!(" (shard {s})"))
@@ -211,14 +235,32 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Marks errors caused by the user's input so that they exit with the bad-input code.
-pub(crate) fn bad_input(e: ExperimentError) -> anyhow::Error {
-    if e.is_bad_input() {
-        let msg = super::describe(&anyhow::Error::from(e));
-        anyhow::Error::new(BadInput(msg))
-    } else {
-        anyhow::Error::new(e)
-    }
+/// A configuration error worded with the flags that set the values it names.
+fn config_error(e: ConfigError) -> BadInput {
+    BadInput(match e {
+        ConfigError::ZeroRuns => "--runs must be at least 1".into(),
+        ConfigError::ZeroBaselineRuns(algos) => format!(
+            "--baseline-runs must be at least 1 (it is the number of runs of {})",
+            algos.join(", ")
+        ),
+        ConfigError::ZeroThreads => "--threads must be at least 1".into(),
+        ConfigError::TooLarge(SizeError::Horizons(n)) => {
+            format!("{n} horizons given; a sweep takes at most {MAX_HORIZONS}")
+        }
+        ConfigError::TooLarge(SizeError::Runs {
+            total,
+            runs,
+            baseline_runs,
+            horizons,
+            algos,
+            meshes,
+        }) => format!(
+            "the sweep has {total} runs (--runs {runs}, --baseline-runs {baseline_runs}, \
+             {horizons} horizon(s), {algos} algorithm(s), {meshes} mesh(es)); a sweep takes at \
+             most {MAX_RUNS}: split it or run fewer"
+        ),
+        other => other.to_string(),
+    })
 }
 
 #[cfg(test)]
@@ -241,5 +283,25 @@ mod tests {
         let err = parse_horizons("1..1000000000").unwrap_err();
         assert!(err.contains("at most 1024"), "{err}");
         assert!(parse_horizons("1..1024").is_ok() && parse_horizons("1..1025").is_err());
+    }
+
+    #[test]
+    fn config_errors_name_their_flags() {
+        let msg = |e| config_error(e).0;
+        assert_eq!(msg(ConfigError::ZeroRuns), "--runs must be at least 1");
+        assert_eq!(
+            msg(ConfigError::ZeroThreads),
+            "--threads must be at least 1"
+        );
+        let m = msg(ConfigError::TooLarge(SizeError::Runs {
+            total: 20_000_000,
+            runs: 2_000_000,
+            baseline_runs: 1,
+            horizons: 10,
+            algos: 1,
+            meshes: 1,
+        }));
+        assert!(m.contains("(--runs 2000000, --baseline-runs 1,"), "{m}");
+        assert_eq!(msg(ConfigError::NoMesh), "no mesh given");
     }
 }

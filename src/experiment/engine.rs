@@ -7,17 +7,18 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use super::ExperimentError;
+use super::events::{Event, Events};
 use super::exec::{Outcome, WorkerFactory, execute};
 use super::manifest::{MANIFEST_FILE, Manifest, OptimumEntry};
 use super::plan::{Job, execution_order, plan, shard};
-use super::progress::{Progress, ProgressMode};
 use super::record::{RunKey, RunRecord};
 use super::store::{self, RUNS_FILE, RunLog};
 use super::summary;
 use crate::stats::describe::effective_branching_factor;
 
-/// Options of one execution of a sweep.
-#[derive(Debug, Clone)]
+/// Options of one execution of a sweep (derived from a
+/// [`SweepConfig`](super::config::SweepConfig) by its `engine_options`).
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct EngineOptions {
     /// Results directory (created if missing).
     pub dir: PathBuf,
@@ -28,8 +29,6 @@ pub struct EngineOptions {
     pub overwrite: bool,
     /// Worker threads.
     pub threads: usize,
-    /// Progress display.
-    pub progress: ProgressMode,
 }
 
 /// What an execution did.
@@ -119,7 +118,7 @@ pub fn check_records(
     for (r, &line) in loaded.records.iter().zip(&loaded.line_numbers) {
         let key = r.key();
         let Some(job) = planned.get(&key) else {
-            return Err(ExperimentError::Mismatch {
+            return Err(ExperimentError::ForeignRecords {
                 dir: path.to_path_buf(),
                 message: format!(
                     "{}:{line}: run {key} is not part of this sweep (or of this shard)",
@@ -132,7 +131,7 @@ pub fn check_records(
             || r.mesh_hash != mesh.hash
             || r.triangles != mesh.triangles
         {
-            return Err(ExperimentError::Mismatch {
+            return Err(ExperimentError::ForeignRecords {
                 dir: path.to_path_buf(),
                 message: format!(
                     "{}:{line}: run {key} has another seed, mesh hash or triangle count than \
@@ -148,7 +147,7 @@ pub fn check_records(
             }
         })?;
         if r.rule() != manifest.spec.rule() {
-            return Err(ExperimentError::Mismatch {
+            return Err(ExperimentError::ForeignRecords {
                 dir: path.to_path_buf(),
                 message: format!(
                     "{}:{line}: run {key} was made under the rule {}, this sweep's is {}",
@@ -359,12 +358,13 @@ pub fn report_files(dir: &Path) -> Result<Vec<String>, ExperimentError> {
 /// A fresh directory must not hold runs yet; with `resume`, its manifest must describe the
 /// same configuration, shard included, and its recorded runs are kept and skipped. Every
 /// finished run is appended and flushed at once. The summary is written at the end, also
-/// after a cancellation (of what was finished).
+/// after a cancellation (of what was finished). Progress goes to `events`.
 pub fn run(
     manifest: &Manifest,
     factory: &dyn WorkerFactory,
     opts: &EngineOptions,
     cancel: &AtomicBool,
+    events: &mut Events<'_>,
 ) -> Result<EngineReport, ExperimentError> {
     let dir = &opts.dir;
     std::fs::create_dir_all(dir).map_err(|e| ExperimentError::io(dir, e))?;
@@ -415,35 +415,31 @@ pub fn run(
     execution_order(&mut todo);
 
     let mut log = RunLog::open_for_append(&runs_path, loaded.valid_len)?;
-    let mut progress = Progress::new(opts.progress, todo.len() as u64);
-    if !done.is_empty() && opts.progress != ProgressMode::Quiet {
-        eprintln!(
-            "sweep: resuming: {} of {} runs already recorded{}",
-            done.len(),
-            jobs.len(),
-            if loaded.torn_bytes > 0 {
-                " (a torn last line was dropped and will be redone)"
-            } else {
-                ""
-            }
-        );
+    if !done.is_empty() {
+        events(Event::Resuming {
+            recorded: done.len(),
+            planned: jobs.len(),
+            torn: loaded.torn_bytes > 0,
+        });
     }
+    events(Event::Started {
+        runs: todo.len() as u64,
+    });
     let result = execute(&todo, opts.threads, factory, cancel, &mut |job, out| {
         let rec = make_record(manifest, job, out);
         // What report and merge would refuse is not recorded: a run that beats the optimum
         // means the optimum is wrong.
         check_values(&rec, manifest.optimum.get(job.mesh)).map_err(|why| {
-            ExperimentError::Run(format!(
-                "run {}: {why}: the optimum recorded for its mesh is wrong (an edited \
-                 optimum cache?); run again with --overwrite",
-                rec.key()
-            ))
+            ExperimentError::OptimumContradicted {
+                run: rec.key().to_string(),
+                why,
+            }
         })?;
         log.append(&rec)?;
-        progress.inc();
+        events(Event::RunDone);
         Ok(())
     });
-    progress.finish();
+    events(Event::Finished);
     let executed = result?;
     log.sync()?;
     drop(log);
@@ -499,7 +495,6 @@ pub(crate) mod tests {
             resume,
             overwrite: false,
             threads,
-            progress: ProgressMode::Quiet,
         }
     }
 
@@ -517,10 +512,10 @@ pub(crate) mod tests {
         let m = manifest(None);
         let no = AtomicBool::new(false);
         let a = tmp.path().join("a");
-        let rep = run(&m, &OK, &opts(&a, 1, false), &no).unwrap();
+        let rep = run(&m, &OK, &opts(&a, 1, false), &no, &mut |_| {}).unwrap();
         assert!(rep.complete() && rep.done_now == 40 && rep.already == 0);
         let b = tmp.path().join("b");
-        run(&m, &OK, &opts(&b, 3, false), &no).unwrap();
+        run(&m, &OK, &opts(&b, 3, false), &no, &mut |_| {}).unwrap();
         assert_eq!(sorted(&a), sorted(&b));
         assert!(b.join("summary.csv").exists() && b.join("summary.json").exists());
 
@@ -535,14 +530,27 @@ pub(crate) mod tests {
             .0
             + 15;
         std::fs::write(b.join(RUNS_FILE), &text[..cut]).unwrap();
-        let rep = run(&m, &OK, &opts(&b, 2, true), &no).unwrap();
+        let mut seen = Vec::new();
+        let mut events = |e: Event<'_>| seen.push(format!("{e:?}"));
+        let rep = run(&m, &OK, &opts(&b, 2, true), &no, &mut events).unwrap();
         assert_eq!((rep.already, rep.done_now, rep.torn), (9, 31, true));
+        // What the caller is told: the resume, the runs to do, each run, the end.
+        let done = format!("{:?}", Event::RunDone);
+        assert_eq!(
+            seen[..2],
+            [
+                "Resuming { recorded: 9, planned: 40, torn: true }",
+                "Started { runs: 31 }"
+            ]
+        );
+        assert_eq!(seen.iter().filter(|e| **e == done).count(), 31);
+        assert_eq!(seen.last().unwrap(), &format!("{:?}", Event::Finished));
         assert_eq!(sorted(&a), sorted(&b));
         let lines = std::fs::read_to_string(b.join(RUNS_FILE)).unwrap();
         assert_eq!(lines.lines().count(), 40);
 
         // Resuming a complete directory does nothing.
-        let rep = run(&m, &OK, &opts(&b, 2, true), &no).unwrap();
+        let rep = run(&m, &OK, &opts(&b, 2, true), &no, &mut |_| {}).unwrap();
         assert_eq!((rep.already, rep.done_now), (40, 0));
     }
 
@@ -551,18 +559,18 @@ pub(crate) mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let m = manifest(None);
         let no = AtomicBool::new(false);
-        run(&m, &OK, &opts(tmp.path(), 1, false), &no).unwrap();
-        let err = run(&m, &OK, &opts(tmp.path(), 1, false), &no).unwrap_err();
+        run(&m, &OK, &opts(tmp.path(), 1, false), &no, &mut |_| {}).unwrap();
+        let err = run(&m, &OK, &opts(tmp.path(), 1, false), &no, &mut |_| {}).unwrap_err();
         assert!(
             matches!(err, ExperimentError::AlreadyExists { records: 40, .. }),
             "{err}"
         );
         let mut other = m.clone();
         other.spec.runs = 6;
-        let err = run(&other, &OK, &opts(tmp.path(), 1, true), &no).unwrap_err();
+        let err = run(&other, &OK, &opts(tmp.path(), 1, true), &no, &mut |_| {}).unwrap_err();
         assert!(err.to_string().contains("runs 6 vs 5"), "{err}");
         let sharded = manifest(Some(Shard { index: 1, count: 2 }));
-        let err = run(&sharded, &OK, &opts(tmp.path(), 1, true), &no).unwrap_err();
+        let err = run(&sharded, &OK, &opts(tmp.path(), 1, true), &no, &mut |_| {}).unwrap_err();
         assert!(
             err.to_string().contains("shard 1/2 vs the whole run list"),
             "{err}"
@@ -574,10 +582,10 @@ pub(crate) mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let m = manifest(None);
         let yes = AtomicBool::new(true);
-        let rep = run(&m, &OK, &opts(tmp.path(), 2, false), &yes).unwrap();
+        let rep = run(&m, &OK, &opts(tmp.path(), 2, false), &yes, &mut |_| {}).unwrap();
         assert!(rep.cancelled && rep.done_now == 0 && !rep.complete());
         let no = AtomicBool::new(false);
-        let rep = run(&m, &OK, &opts(tmp.path(), 2, true), &no).unwrap();
+        let rep = run(&m, &OK, &opts(tmp.path(), 2, true), &no, &mut |_| {}).unwrap();
         assert!(rep.complete() && !rep.cancelled);
     }
 

@@ -6,7 +6,10 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use super::ExperimentError;
+use super::manifest::OptimumEntry;
 use super::plan::Job;
+use crate::quality::{CandidateTable, ElementQuality};
+use crate::search::RunOutcome;
 
 /// What a run produced, apart from what identifies it.
 #[derive(Debug, Clone, PartialEq)]
@@ -26,7 +29,39 @@ pub struct Outcome {
     /// Seconds of search.
     pub time_s: f64,
     /// Worst and mean eta of the quads, and the poor ones.
-    pub elements: crate::quality::ElementQuality,
+    pub elements: ElementQuality,
+}
+
+impl Outcome {
+    /// The outcome of a search run, with its quads' eta figures from `table` (the one
+    /// conversion from [`RunOutcome`]).
+    pub fn of_run(out: &RunOutcome, table: &CandidateTable) -> Outcome {
+        Outcome {
+            quads: out.quads,
+            triangles_left: out.triangles_left,
+            quality: out.quality,
+            nodes_expanded: out.nodes_expanded,
+            trees: out.trees,
+            decisions: out.decisions,
+            time_s: out.time_s,
+            elements: ElementQuality::of_chosen(table, &out.chosen),
+        }
+    }
+
+    /// The outcome recorded for the optimum's run: its matching, no tree, one decision per
+    /// quad, the time the matching took.
+    pub fn of_optimum(o: &OptimumEntry) -> Outcome {
+        Outcome {
+            quads: o.quads,
+            triangles_left: o.triangles_left,
+            quality: o.quality,
+            nodes_expanded: 0,
+            trees: 0,
+            decisions: o.quads as u64,
+            time_s: o.time_s,
+            elements: o.elements,
+        }
+    }
 }
 
 /// Runs jobs one after another on one thread, keeping whatever it reuses between them.
@@ -65,7 +100,7 @@ pub fn execute(
         .num_threads(threads)
         .thread_name(|i| format!("sweep-{i}"))
         .build()
-        .map_err(|e| ExperimentError::Invalid(format!("cannot start {threads} threads: {e}")))?;
+        .map_err(|e| ExperimentError::Run(format!("cannot start {threads} threads: {e}")))?;
     let next = AtomicUsize::new(0);
     let failed = AtomicBool::new(false);
     let error: Mutex<Option<ExperimentError>> = Mutex::new(None);

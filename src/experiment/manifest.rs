@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 use super::ExperimentError;
+use super::config::SizeError;
 
 /// File name of the manifest in a results directory.
 pub const MANIFEST_FILE: &str = "manifest.json";
@@ -224,24 +225,21 @@ impl Manifest {
         // What a sweep would have refused is refused here too, before a run list is built
         // from it (a manifest with runs 4294967295 made report and merge plan 8.6e9 runs).
         let s = &m.spec;
-        let runs = super::plan::planned_runs(
+        let size = super::config::check_size(
             s.meshes.len(),
             &s.algos,
             s.horizons.len(),
             s.runs,
             s.baseline_runs,
         );
-        let why = if s.horizons.len() > super::sweep::MAX_HORIZONS {
-            Some(format!(
-                "{} horizons, more than a sweep takes ({})",
-                s.horizons.len(),
-                super::sweep::MAX_HORIZONS
-            ))
-        } else if runs > super::sweep::MAX_RUNS {
-            Some(format!(
-                "its spec makes {runs} runs, more than a sweep takes ({})",
-                super::sweep::MAX_RUNS
-            ))
+        let why = if let Err(e) = size {
+            Some(match e {
+                SizeError::Runs { total, .. } => format!(
+                    "its spec makes {total} runs, more than a sweep takes ({})",
+                    super::config::MAX_RUNS
+                ),
+                e => e.to_string(),
+            })
         } else if m.optimum.len() > s.meshes.len() {
             Some("more optimum entries than meshes".to_string())
         } else if let Err(e) = crate::quality::Rule::new(s.min_eta, s.allow_invalid) {

@@ -31,11 +31,10 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     }
     if let Ok(meta) = std::fs::metadata(out) {
         if !meta.is_dir() {
-            return Err(ExperimentError::Merge(format!(
-                "--out {}: is {}, not a directory (merge writes a results directory)",
-                out.display(),
-                crate::mesh::file_kind(&meta)
-            )));
+            return Err(ExperimentError::NotADirectory {
+                dir: out.to_path_buf(),
+                kind: crate::mesh::file_kind(&meta).to_string(),
+            });
         }
     }
     let mut manifests = Vec::new();
@@ -62,7 +61,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
             && a.count != b.count
         {
             return Err(ExperimentError::Merge(format!(
-                "{} is shard {}/{} but {} is shard {}/{}: shards of one sweep share the same --shard count",
+                "{} is shard {}/{} but {} is shard {}/{}: shards of one sweep are cut with the same shard count",
                 parts[0].display(),
                 a.index,
                 a.count,
@@ -85,10 +84,9 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     for (i, (p, m)) in parts.iter().zip(&manifests).enumerate() {
         let loaded = store::read(&p.join(RUNS_FILE))?;
         if loaded.torn_bytes > 0 {
-            return Err(ExperimentError::Merge(format!(
-                "{} ends with a torn line (the sweep was interrupted): run `quadrecomb sweep --resume` there first",
-                p.join(RUNS_FILE).display()
-            )));
+            return Err(ExperimentError::TornPart {
+                path: p.join(RUNS_FILE),
+            });
         }
         // Every record must be a run of the whole list with the right seed (a shard's records
         // are runs of the whole list too).
@@ -119,7 +117,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     if !missing.is_empty() {
         let list: Vec<String> = missing.iter().take(5).map(|k| k.to_string()).collect();
         return Err(ExperimentError::Merge(format!(
-            "{} of {} runs are missing (a shard not given, not finished, or run with another --shard count?), e.g.: {}",
+            "{} of {} runs are missing (a shard not given, not finished, or cut with another shard count?), e.g.: {}",
             missing.len(),
             jobs.len(),
             list.join("; ")
@@ -175,6 +173,7 @@ mod tests {
             &OK,
             &opts(dir, 2, false),
             &AtomicBool::new(false),
+            &mut |_| {},
         )
         .unwrap();
     }
@@ -256,7 +255,14 @@ mod tests {
         let other = tmp.path().join("other");
         let mut m = manifest(Some(Shard { index: 3, count: 3 }));
         m.spec.seed += 1;
-        run(&m, &OK, &opts(&other, 1, false), &AtomicBool::new(false)).unwrap();
+        run(
+            &m,
+            &OK,
+            &opts(&other, 1, false),
+            &AtomicBool::new(false),
+            &mut |_| {},
+        )
+        .unwrap();
         let err = merge(&[s[0].clone(), s[1].clone(), other], &tmp.path().join("o3"))
             .unwrap_err()
             .to_string();

@@ -6,13 +6,14 @@
 //! flushed line of `runs.jsonl` ([`store`]), and the directory can be resumed after a kill,
 //! split into shards and merged back ([`merge`]). [`summary`] turns records into statistics.
 
+pub mod config;
 pub mod engine;
+pub mod events;
 pub mod exec;
 pub mod lock;
 pub mod manifest;
 pub mod merge;
 pub mod plan;
-pub mod progress;
 pub mod record;
 pub mod seed;
 pub mod store;
@@ -50,10 +51,18 @@ pub enum ExperimentError {
         /// The first difference found.
         message: String,
     },
-    /// The output directory already holds runs and `--resume` was not given.
-    #[error(
-        "{dir}: already holds {records} run(s); pass --resume to continue that sweep, --overwrite to replace it, or choose another --out"
-    )]
+    /// A results directory's records do not fit its own manifest (runs of another sweep,
+    /// shard, seed or rule).
+    #[error("{dir}: holds results of a different configuration: {message}")]
+    ForeignRecords {
+        /// The directory.
+        dir: PathBuf,
+        /// The first record that does not fit, with its line.
+        message: String,
+    },
+    /// A fresh sweep was pointed at a directory that already holds runs (neither resumed nor
+    /// replaced).
+    #[error("{dir}: already holds {records} run(s) of a sweep")]
     AlreadyExists {
         /// The directory.
         dir: PathBuf,
@@ -61,18 +70,24 @@ pub enum ExperimentError {
         records: usize,
     },
     /// `merge` was pointed at a directory that already holds runs.
-    #[error(
-        "{dir}: already holds {records} run(s); merge writes into a new or empty directory: choose another --out or remove that one"
-    )]
+    #[error("{dir}: already holds {records} run(s); merge writes into a new or empty directory")]
     MergeTargetNotEmpty {
         /// The directory.
         dir: PathBuf,
         /// Records found.
         records: usize,
     },
+    /// The directory to write results into exists and is not a directory.
+    #[error("{dir}: is {kind}, not a directory (results go into a directory)")]
+    NotADirectory {
+        /// The path.
+        dir: PathBuf,
+        /// What it is ("a regular file", ...).
+        kind: String,
+    },
     /// Another live process is writing the results directory.
     #[error(
-        "{dir}: another sweep{} is writing there; wait for it, stop it, or choose another --out",
+        "{dir}: another sweep{} is writing there",
         pid.map_or(String::new(), |p| format!(" (process {p})"))
     )]
     Busy {
@@ -80,6 +95,14 @@ pub enum ExperimentError {
         dir: PathBuf,
         /// The process holding the lock on `DIR/.lock`, when it could be read.
         pid: Option<u32>,
+    },
+    /// A part to merge ends with a torn line: its sweep was interrupted and not resumed.
+    #[error(
+        "{path} ends with a torn line (the sweep was interrupted): resume that sweep there first"
+    )]
+    TornPart {
+        /// The part's run log.
+        path: PathBuf,
     },
     /// Shards cannot be merged: missing, duplicated or foreign runs.
     #[error("merge: {0}")]
@@ -99,6 +122,18 @@ pub enum ExperimentError {
         #[source]
         source: crate::mesh::ReadError,
     },
+    /// A run did what the optimum recorded for its mesh says no run can: that optimum is
+    /// wrong (an edited optimum cache); replacing the results recomputes it.
+    #[error(
+        "run {run}: {why}: the optimum recorded for its mesh is wrong (an edited optimum \
+         cache?); replace the sweep's results to recompute it"
+    )]
+    OptimumContradicted {
+        /// The run's key.
+        run: String,
+        /// What the run did.
+        why: String,
+    },
     /// A run failed.
     #[error("{0}")]
     Run(String),
@@ -110,22 +145,6 @@ impl ExperimentError {
             path: path.to_path_buf(),
             source,
         }
-    }
-
-    /// Whether the user's input (arguments, directories) is at fault rather than the program
-    /// or the system.
-    pub fn is_bad_input(&self) -> bool {
-        matches!(
-            self,
-            ExperimentError::Corrupt { .. }
-                | ExperimentError::Mismatch { .. }
-                | ExperimentError::AlreadyExists { .. }
-                | ExperimentError::MergeTargetNotEmpty { .. }
-                | ExperimentError::Busy { .. }
-                | ExperimentError::Merge(_)
-                | ExperimentError::Invalid(_)
-                | ExperimentError::Mesh { .. }
-        )
     }
 }
 

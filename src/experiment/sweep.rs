@@ -2,165 +2,24 @@
 //! over all meshes), the optimum once per mesh (cached by mesh hash), and runs the searches
 //! through [`super::engine`] with one reusable [`Searcher`] per thread and mesh.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 use super::ExperimentError;
-use super::engine::{self, EngineOptions, EngineReport};
+use super::config::SweepConfig;
+use super::engine::{self, EngineReport};
+use super::events::{Event, Events};
 use super::exec::{Outcome, Worker, WorkerFactory};
-use super::manifest::{Machine, Manifest, MeshEntry, OptimumEntry, Shard, SweepSpec};
-use super::plan::{Job, has_horizon};
-use super::progress::ProgressMode;
-use super::record::ALGO_NAMES;
+use super::manifest::{Machine, Manifest, MeshEntry, OptimumEntry};
+use super::plan::Job;
 use super::seed::{eta_hash, mesh_hash};
-use crate::gpu::{Backend, Evaluator};
+use crate::gpu::Evaluator;
 use crate::mesh::Mesh;
-use crate::quality::{CandidateTable, ElementQuality, Rule};
+use crate::quality::{CandidateTable, ElementQuality};
 use crate::search::{Algo, Searcher};
 
-/// Algorithms of the default sweep (the paper's experiment), in order.
-pub const DEFAULT_ALGOS: &[&str] = &["selective", "greedy", "greedy-nocrit", "optimum"];
-/// The default base seed.
-pub const DEFAULT_SEED: u64 = 2026;
-/// Most horizons one sweep takes.
-pub const MAX_HORIZONS: usize = 1024;
-/// Most runs one sweep plans (its run list is held in memory, each run a line of the log).
-pub const MAX_RUNS: u64 = 10_000_000;
 /// Directory of the optimum cache inside a results directory.
 pub const OPTIMUM_CACHE_DIR: &str = "optimum-cache";
-
-/// A validated sweep configuration (what `quadrecomb sweep` parses its arguments into).
-#[derive(Debug, Clone)]
-pub struct SweepConfig {
-    /// Meshes: built-in names or paths.
-    pub meshes: Vec<String>,
-    /// Algorithm names (see [`ALGO_NAMES`]).
-    pub algos: Vec<String>,
-    /// Horizons of `uniform` and `selective`.
-    pub horizons: Vec<u32>,
-    /// Runs per (mesh, tree algorithm, horizon).
-    pub runs: u32,
-    /// Runs of `greedy` and `greedy-nocrit` per mesh.
-    pub baseline_runs: u32,
-    /// Base seed.
-    pub seed: u64,
-    /// Worker threads.
-    pub threads: usize,
-    /// Who computes eta.
-    pub backend: Backend,
-    /// Which pairs may be merged (valid quads by default).
-    pub rule: Rule,
-    /// Results directory.
-    pub out: PathBuf,
-    /// Continue the sweep in `out`.
-    pub resume: bool,
-    /// Replace an earlier sweep's results in `out`.
-    pub overwrite: bool,
-    /// Run only this slice of the run list.
-    pub shard: Option<Shard>,
-    /// Progress display.
-    pub progress: ProgressMode,
-}
-
-impl SweepConfig {
-    /// The paper's experiment on `borouchaki` into `results/borouchaki`.
-    pub fn paper() -> SweepConfig {
-        SweepConfig {
-            meshes: vec!["borouchaki".into()],
-            algos: DEFAULT_ALGOS.iter().map(|s| s.to_string()).collect(),
-            horizons: (1..=10).collect(),
-            runs: 128,
-            baseline_runs: 1,
-            seed: DEFAULT_SEED,
-            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
-            backend: Backend::Auto,
-            rule: Rule::default(),
-            out: PathBuf::from("results/borouchaki"),
-            resume: false,
-            overwrite: false,
-            shard: None,
-            progress: ProgressMode::Auto,
-        }
-    }
-
-    /// Checks the configuration before any work starts.
-    pub fn validate(&self) -> Result<(), ExperimentError> {
-        let bad = |m: String| Err(ExperimentError::Invalid(m));
-        if self.meshes.is_empty() {
-            return bad("no mesh given".into());
-        }
-        if self.algos.is_empty() {
-            return bad("no algorithm given".into());
-        }
-        for (i, a) in self.algos.iter().enumerate() {
-            if !ALGO_NAMES.contains(&a.as_str()) {
-                return bad(format!(
-                    "unknown algorithm {a:?} (expected one of {})",
-                    ALGO_NAMES.join(", ")
-                ));
-            }
-            if self.algos[..i].contains(a) {
-                return bad(format!("algorithm {a:?} given twice"));
-            }
-        }
-        if self.algos.iter().any(|a| has_horizon(a)) {
-            if self.horizons.is_empty() {
-                return bad("no horizon given".into());
-            }
-            if self.horizons.contains(&0) {
-                return bad("horizons must be at least 1".into());
-            }
-            if self.runs == 0 {
-                return bad("--runs must be at least 1".into());
-            }
-        }
-        // `--baseline-runs` counts the greedy runs (the optimum always runs once).
-        let baselines: Vec<&str> = (self.algos.iter().map(String::as_str))
-            .filter(|a| matches!(*a, "greedy" | "greedy-nocrit"))
-            .collect();
-        if self.baseline_runs == 0 && !baselines.is_empty() {
-            return bad(format!(
-                "--baseline-runs must be at least 1 (it is the number of runs of {})",
-                baselines.join(", ")
-            ));
-        }
-        for (i, h) in self.horizons.iter().enumerate() {
-            if self.horizons[..i].contains(h) {
-                return bad(format!("horizon {h} given twice"));
-            }
-        }
-        if self.threads == 0 {
-            return bad("--threads must be at least 1".into());
-        }
-        if self.horizons.len() > MAX_HORIZONS {
-            return bad(format!(
-                "{} horizons given; a sweep takes at most {MAX_HORIZONS}",
-                self.horizons.len()
-            ));
-        }
-        // Counted before the run list is built (it is held in memory).
-        let total = super::plan::planned_runs(
-            self.meshes.len(),
-            &self.algos,
-            self.horizons.len(),
-            self.runs,
-            self.baseline_runs,
-        );
-        if total > MAX_RUNS {
-            return bad(format!(
-                "the sweep has {total} runs (--runs {}, --baseline-runs {}, {} horizon(s), {} \
-                 algorithm(s), {} mesh(es)); a sweep takes at most {MAX_RUNS}: split it or run \
-                 fewer",
-                self.runs,
-                self.baseline_runs,
-                self.horizons.len(),
-                self.algos.len(),
-                self.meshes.len()
-            ));
-        }
-        Ok(())
-    }
-}
 
 /// Meshes with their eta filled, optima computed, and the manifest of the sweep.
 #[derive(Debug)]
@@ -184,12 +43,12 @@ pub fn mesh_name(spec: &str) -> String {
 }
 
 /// Loads the meshes, fills eta in one evaluator batch, and finds (or computes and caches
-/// under `config.out`) the optimum of each mesh.
-pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
-    config.validate()?;
+/// under the results directory) the optimum of each mesh. How the backend was chosen goes
+/// to `events`.
+pub fn prepare(config: &SweepConfig, events: &mut Events<'_>) -> Result<Prepared, ExperimentError> {
     let mut meshes = Vec::new();
     let mut entries: Vec<MeshEntry> = Vec::new();
-    for spec in &config.meshes {
+    for spec in config.meshes() {
         let mesh = crate::mesh::load(spec).map_err(|source| ExperimentError::Mesh {
             spec: spec.clone(),
             source,
@@ -220,7 +79,10 @@ pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
         entries.push(entry);
         meshes.push(mesh);
     }
-    let evaluator = Evaluator::new(config.backend)?;
+    let evaluator = Evaluator::new(config.backend())?;
+    for note in evaluator.notes() {
+        events(Event::Backend(note));
+    }
     let mut tables: Vec<CandidateTable> =
         meshes.iter().map(CandidateTable::topology_only).collect();
     {
@@ -229,39 +91,26 @@ pub fn prepare(config: &SweepConfig) -> Result<Prepared, ExperimentError> {
         evaluator.fill(&mut jobs)?;
     }
     let tables: Vec<CandidateTable> = (meshes.iter().zip(tables))
-        .map(|(mesh, table)| table.restrict(mesh, config.rule))
+        .map(|(mesh, table)| table.restrict(mesh, config.rule()))
         .collect();
     let mut optimum = Vec::new();
     for ((mesh, table), entry) in meshes.iter().zip(&tables).zip(&entries) {
         optimum.push(cached_optimum(
-            &config.out,
+            config.out(),
             mesh,
             table,
             entry,
-            config.overwrite,
+            config.overwrite(),
         )?);
     }
     let manifest = Manifest {
         version: super::VERSION.to_string(),
-        spec: SweepSpec {
-            meshes: entries,
-            algos: config.algos.clone(),
-            horizons: if config.algos.iter().any(|a| has_horizon(a)) {
-                config.horizons.clone()
-            } else {
-                Vec::new()
-            },
-            runs: config.runs,
-            baseline_runs: config.baseline_runs,
-            seed: config.seed,
-            min_eta: config.rule.min_eta(),
-            allow_invalid: config.rule.allows_invalid(),
-        },
+        spec: config.spec(entries),
         backend: evaluator.name().to_string(),
-        backend_requested: config.backend.to_string(),
+        backend_requested: config.backend().to_string(),
         optimum,
-        shard: config.shard,
-        threads: config.threads,
+        shard: config.shard(),
+        threads: config.threads(),
         machine: Machine::current(),
         merged_from: Vec::new(),
     };
@@ -407,17 +256,7 @@ impl WorkerFactory for SearchFactory<'_> {
 impl Worker for SearchWorker<'_> {
     fn run(&mut self, job: &Job) -> Result<Outcome, ExperimentError> {
         if job.algo == "optimum" {
-            let o = &self.factory.optimum[job.mesh];
-            return Ok(Outcome {
-                quads: o.quads,
-                triangles_left: o.triangles_left,
-                quality: o.quality,
-                nodes_expanded: 0,
-                trees: 0,
-                decisions: o.quads as u64,
-                time_s: o.time_s,
-                elements: o.elements,
-            });
+            return Ok(Outcome::of_optimum(&self.factory.optimum[job.mesh]));
         }
         let algo = Algo::from_name(&job.algo, job.horizon.unwrap_or(1))
             .map_err(|e| ExperimentError::Invalid(e.to_string()))?;
@@ -425,37 +264,25 @@ impl Worker for SearchWorker<'_> {
         let searcher = self.searchers[job.mesh]
             .get_or_insert_with(|| Searcher::new(&f.meshes[job.mesh], &f.tables[job.mesh]));
         let out = searcher.run(algo, job.seed);
-        Ok(Outcome {
-            elements: ElementQuality::of_chosen(&f.tables[job.mesh], &out.chosen),
-            quads: out.quads,
-            triangles_left: out.triangles_left,
-            quality: out.quality,
-            nodes_expanded: out.nodes_expanded,
-            trees: out.trees,
-            decisions: out.decisions,
-            time_s: out.time_s,
-        })
+        Ok(Outcome::of_run(&out, &f.tables[job.mesh]))
     }
 }
 
-/// Prepares and runs a sweep into `config.out`; `cancel` stops it between runs.
+/// Prepares and runs a sweep into its results directory; `cancel` stops it between runs,
+/// progress and notices go to `events`.
 pub fn run(
     config: &SweepConfig,
     cancel: &AtomicBool,
+    events: &mut Events<'_>,
 ) -> Result<(Manifest, EngineReport), ExperimentError> {
-    let prepared = prepare(config)?;
+    let prepared = prepare(config, events)?;
     let factory = SearchFactory::new(&prepared);
     let report = engine::run(
         &prepared.manifest,
         &factory,
-        &EngineOptions {
-            dir: config.out.clone(),
-            resume: config.resume,
-            overwrite: config.overwrite,
-            threads: config.threads,
-            progress: config.progress,
-        },
+        &config.engine_options(),
         cancel,
+        events,
     )?;
     Ok((prepared.manifest.clone(), report))
 }

@@ -27,8 +27,8 @@ pub use layout::Batch;
 use crate::mesh::Mesh;
 use crate::quality::CandidateTable;
 
-/// Which device computes the qualities (`--backend`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+/// Which device computes the qualities.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Backend {
     /// A real GPU if present, else lavapipe (software Vulkan), else the CPU twin.
     #[default]
@@ -55,10 +55,10 @@ impl std::fmt::Display for Backend {
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
     /// No Vulkan adapter: install a GPU driver, or lavapipe (Debian: mesa-vulkan-drivers),
-    /// or use `--backend cpu`.
+    /// or use [`Backend::Cpu`].
     #[error(
         "no Vulkan adapter found (install a GPU driver or lavapipe, Debian package \
-         mesa-vulkan-drivers, or use --backend cpu)"
+         mesa-vulkan-drivers, or use the CPU backend)"
     )]
     NoAdapter,
     /// The adapter refused to open a device.
@@ -86,11 +86,51 @@ pub enum GpuError {
     TooLarge(String),
 }
 
+/// What [`Backend::Auto`] decided while opening an [`Evaluator`], for the caller to show
+/// ([`Evaluator::notes`]; the library prints nothing).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum BackendNote {
+    /// An adapter was opened: a real GPU, or a software one when no GPU was found.
+    Picked {
+        /// The adapter's name, as recorded ([`Evaluator::name`]).
+        adapter: String,
+        /// Whether it is a software adapter (lavapipe).
+        software: bool,
+    },
+    /// An adapter was found but could not be used; the next one is tried.
+    AdapterFailed {
+        /// The adapter's name.
+        adapter: String,
+        /// Why it failed.
+        error: String,
+    },
+    /// No adapter could be used: the CPU twin computes the qualities.
+    CpuFallback,
+}
+
+impl std::fmt::Display for BackendNote {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BackendNote::Picked {
+                adapter,
+                software: true,
+            } => write!(
+                f,
+                "no GPU found, using the software Vulkan adapter {adapter}"
+            ),
+            BackendNote::Picked { adapter, .. } => write!(f, "using the GPU {adapter}"),
+            BackendNote::AdapterFailed { adapter, error } => write!(f, "{adapter} failed: {error}"),
+            BackendNote::CpuFallback => f.write_str("no usable Vulkan adapter, using the CPU twin"),
+        }
+    }
+}
+
 /// A device (or the CPU twin) opened once, that fills candidate tables' eta.
 #[derive(Debug)]
 pub struct Evaluator {
     name: String,
     gpu: Option<Gpu>,
+    notes: Vec<BackendNote>,
 }
 
 #[derive(Debug)]
@@ -101,14 +141,15 @@ struct Gpu {
 }
 
 impl Evaluator {
-    /// Opens the device `backend` asks for and builds the kernel (once); `auto` says on
-    /// stderr which backend it picked and why.
+    /// Opens the device `backend` asks for and builds the kernel (once); with `auto`, which
+    /// backend it picked and why is in [`Evaluator::notes`].
     pub fn new(backend: Backend) -> Result<Evaluator, GpuError> {
         if backend == Backend::Cpu {
             return Ok(Evaluator::cpu_twin());
         }
         let found = adapters();
         let mut last_err = None;
+        let mut notes = Vec::new();
         for adapter in &found {
             let info = adapter.get_info();
             let opened = open_device(adapter).and_then(|(device, queue)| {
@@ -121,24 +162,25 @@ impl Evaluator {
             });
             match opened {
                 Ok(gpu) => {
-                    let ev = Evaluator {
+                    if backend == Backend::Auto {
+                        notes.push(BackendNote::Picked {
+                            adapter: adapter_name(&info),
+                            software: is_software(&info),
+                        });
+                    }
+                    return Ok(Evaluator {
                         name: adapter_name(&info),
                         gpu: Some(gpu),
-                    };
-                    if backend == Backend::Auto {
-                        let kind = if is_software(&info) {
-                            "no GPU found, using the software Vulkan adapter"
-                        } else {
-                            "using the GPU"
-                        };
-                        eprintln!("quality backend: {kind} {}", ev.name);
-                    }
-                    return Ok(ev);
+                        notes,
+                    });
                 }
                 Err(e @ GpuError::Shader { .. }) => return Err(e),
                 Err(e) => {
                     if backend == Backend::Auto {
-                        eprintln!("quality backend: {} failed: {e}", adapter_name(&info));
+                        notes.push(BackendNote::AdapterFailed {
+                            adapter: adapter_name(&info),
+                            error: e.to_string(),
+                        });
                     }
                     last_err = Some(e);
                 }
@@ -146,8 +188,11 @@ impl Evaluator {
         }
         match backend {
             Backend::Auto => {
-                eprintln!("quality backend: no usable Vulkan adapter, using the CPU twin");
-                Ok(Evaluator::cpu_twin())
+                notes.push(BackendNote::CpuFallback);
+                Ok(Evaluator {
+                    notes,
+                    ..Evaluator::cpu_twin()
+                })
             }
             _ => Err(last_err.unwrap_or(GpuError::NoAdapter)),
         }
@@ -158,7 +203,13 @@ impl Evaluator {
         Evaluator {
             name: "cpu-twin".to_string(),
             gpu: None,
+            notes: Vec::new(),
         }
+    }
+
+    /// What [`Backend::Auto`] decided while opening (empty for the other backends), in order.
+    pub fn notes(&self) -> &[BackendNote] {
+        &self.notes
     }
 
     /// What computes the qualities, recorded in results: e.g. `vulkan: NVIDIA H200`,

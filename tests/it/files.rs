@@ -193,7 +193,7 @@ fn concurrent_sweeps_never_interleave_records() {
             let o = c.wait_with_output().unwrap();
             match o.status.code() {
                 Some(0) => ok += 1,
-                Some(2) if stderr(&o).contains("another sweep") => {}
+                Some(4) if stderr(&o).contains("another sweep") => {}
                 _ => panic!("round {round}: {:?}: {}", o.status, stderr(&o)),
             }
         }
@@ -459,7 +459,7 @@ fn report_and_merge_refuse_records_no_run_can_have() {
         ] {
             let o = run_in(tmp.path(), cmd);
             let e = stderr(&o);
-            assert_eq!(o.status.code(), Some(2), "{cmd:?} {why}: {e}");
+            assert_eq!(o.status.code(), Some(3), "{cmd:?} {why}: {e}");
             assert!(
                 e.contains(why) && e.contains(&at),
                 "{cmd:?} {why} {at}: {e}"
@@ -656,7 +656,7 @@ fn inputs_that_never_end_are_refused_from_their_first_bytes() {
     for (input, msg) in &cases {
         for cmd in ["info", "optimum"] {
             let o = run_limited(tmp.path(), "ulimit -v 1000000", &[cmd, input], 20);
-            assert_eq!(o.status.code(), Some(2), "{cmd} {input}: {}", stderr(&o));
+            assert_eq!(o.status.code(), Some(3), "{cmd} {input}: {}", stderr(&o));
             assert!(stderr(&o).contains(msg), "{cmd} {input}: {}", stderr(&o));
         }
     }
@@ -782,7 +782,7 @@ fn merge_into_a_file_is_named() {
     small_sweep(tmp.path(), "d", &["--no-report"]);
     std::fs::write(tmp.path().join("m"), "mine").unwrap();
     let o = run_in(tmp.path(), &["merge", "d", "--out", "m"]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
     assert!(
         stderr(&o).contains("--out m: is a regular file, not a directory"),
         "{}",
@@ -959,7 +959,7 @@ fn fuzz_manifest_with_huge_runs_is_refused() {
         &["merge", "d", "--out", "m"],
     ] {
         let o = run_limited(tmp.path(), "ulimit -v 4000000", cmd, 20);
-        assert_eq!(o.status.code(), Some(2), "{cmd:?}: {}", stderr(&o));
+        assert_eq!(o.status.code(), Some(3), "{cmd:?}: {}", stderr(&o));
         assert!(
             stderr(&o).contains("makes 8589934591 runs, more than a sweep takes (10000000)"),
             "{}",

@@ -470,7 +470,7 @@ fn other_formats_get_a_conversion_command_that_works() {
         let path = dir.path().join(name);
         std::fs::write(&path, text).unwrap();
         let out = run_in(dir.path(), &["info", name]);
-        assert_eq!(out.status.code(), Some(2));
+        assert_eq!(out.status.code(), Some(3));
         let err = String::from_utf8_lossy(&out.stderr).to_string();
         assert!(err.contains("unknown mesh format"), "{err}");
         // Each suggested command, between backticks, run as written.
@@ -504,13 +504,13 @@ fn other_formats_get_a_conversion_command_that_works() {
     }
 }
 
-/// Runs `quadrecomb info path` and checks exit code 2, no panic, and that the message names
+/// Runs `quadrecomb info path` and checks exit code 3 (bad input), no panic, and that the message names
 /// the file and says each of `expect`.
 fn assert_bad(path: &Path, expect: &[&str]) -> String {
     let dir = tempfile::tempdir().unwrap();
     let out = run_in(dir.path(), &["info", path.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(out.status.code(), Some(2), "{}: {err}", path.display());
+    assert_eq!(out.status.code(), Some(3), "{}: {err}", path.display());
     assert!(!err.contains("panicked"), "{err}");
     let file = path.file_name().unwrap().to_str().unwrap();
     assert!(err.contains(file), "message does not name {file}: {err}");
@@ -984,7 +984,7 @@ fn bench_io_reports_each_mesh() {
     );
     assert_eq!(bad.status.code(), Some(2));
     let missing = run_in(dir.path(), &["bench", "io", "no_such.msh"]);
-    assert_eq!(missing.status.code(), Some(2));
+    assert_eq!(missing.status.code(), Some(3));
 }
 
 /// A mesh of quads only (a fully recombined one, say) is not an error for `info`: it reports
@@ -1024,7 +1024,7 @@ fn info_reports_a_quad_only_mesh() {
         dir.path(),
         &["recombine", p.to_str().unwrap(), "--algo", "greedy"],
     );
-    assert_eq!(rec.status.code(), Some(2));
+    assert_eq!(rec.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&rec.stderr).contains("no triangles"));
     // Its elements are checked as any mesh's: a quad on a node that does not exist is an
     // error naming the file and the element, not a quad left out.
@@ -1034,7 +1034,7 @@ fn info_reports_a_quad_only_mesh() {
     let bad = dir.path().join("bad_quads.msh");
     std::fs::write(&bad, text).unwrap();
     let out = run_in(dir.path(), &["info", bad.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.status.code(), Some(3));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("bad_quads.msh") && err.contains("element 3"),

@@ -70,7 +70,7 @@ fn long_corridors_recombine_in_bounded_memory() {
     }
 }
 
-/// Out of memory is exit code 2 with a message naming what was being done and how much
+/// Out of memory is exit code 5 with a message naming what was being done and how much
 /// could not be had, not an abort (exit 134, "memory allocation of N bytes failed").
 #[test]
 fn out_of_memory_is_an_error_not_an_abort() {
@@ -86,7 +86,7 @@ fn out_of_memory_is_an_error_not_an_abort() {
         // About 90 MB resident for `info`, more for `recombine`: 60 MB cannot do.
         let out = limited(dir.path(), 60_000, cmd);
         let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{cmd:?}: {} {err}", out.status);
+        assert_eq!(out.status.code(), Some(5), "{cmd:?}: {} {err}", out.status);
         assert!(
             err.contains("error: out of memory while") && err.contains("could not allocate"),
             "{cmd:?}: {err}"

@@ -329,7 +329,7 @@ fn cli_optimum_json() {
 fn cli_rejects_missing_mesh() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = run_in(dir.path(), &["optimum", "no-such-mesh.msh"]);
-    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.status.code(), Some(3));
 }
 
 /// MSH 2.2 ASCII text of a triangle mesh (enough for the CLI test).

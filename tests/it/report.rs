@@ -790,14 +790,14 @@ fn report_command_writes_files_and_rejects_bad_input() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--zoom"));
     let err = |out: &std::process::Output| String::from_utf8_lossy(&out.stderr).into_owned();
     let out = run_in(tmp.path(), &["report", "missing-dir"]);
-    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.status.code(), Some(3));
     assert!(
         err(&out).contains("missing-dir: no such directory"),
         "{}",
         err(&out)
     );
     let out = run_in(tmp.path(), &["report", "res/runs.jsonl"]);
-    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.status.code(), Some(3));
     assert!(err(&out).contains("not a directory"), "{}", err(&out));
     // A configuration to picture that the results do not hold is an error, not ignored.
     for bad in ["bogus", "selective:9"] {

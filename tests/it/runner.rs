@@ -232,7 +232,7 @@ fn torn_last_line_is_redone_on_resume_and_fresh_sweep_refuses_a_used_dir() {
     assert_eq!(store::read(&runs).unwrap().records.len(), want.len() - 4);
 
     let again = sweep(dir, &args, &[]);
-    assert_eq!(again.status.code(), Some(2), "{}", stderr(&again));
+    assert_eq!(again.status.code(), Some(4), "{}", stderr(&again));
     assert!(stderr(&again).contains("--resume"), "{}", stderr(&again));
 
     let resumed = sweep(dir, &args, &["--resume"]);
@@ -249,7 +249,7 @@ fn torn_last_line_is_redone_on_resume_and_fresh_sweep_refuses_a_used_dir() {
 
     // Resuming with another configuration is refused.
     let other = sweep(dir, &sweep_args(&mesh, "out", 5, "1..3"), &["--resume"]);
-    assert_eq!(other.status.code(), Some(2));
+    assert_eq!(other.status.code(), Some(4));
     assert!(stderr(&other).contains("runs 5 vs 4"), "{}", stderr(&other));
 }
 
@@ -277,7 +277,7 @@ fn overwrite_replaces_an_earlier_sweep_with_another_configuration() {
     std::fs::write(&mine, "<svg/>").unwrap();
     let args = sweep_args(&mesh, "out", 3, "1..2");
     let refused = sweep(dir, &args, &[]);
-    assert_eq!(refused.status.code(), Some(2));
+    assert_eq!(refused.status.code(), Some(4));
     assert!(
         stderr(&refused).contains("--overwrite"),
         "{}",
@@ -321,7 +321,7 @@ fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
     assert!(wait_for_lines(&runs, 10, Duration::from_secs(60)) >= 10);
     // A second sweep into the same directory while the first runs is refused.
     let second = sweep(dir, &args, &["--resume"]);
-    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert_eq!(second.status.code(), Some(4), "{}", stderr(&second));
     assert!(
         stderr(&second).contains("another sweep"),
         "{}",
@@ -367,7 +367,7 @@ fn a_second_sweep_into_a_busy_directory_is_refused() {
         still_running,
         "the first sweep ended too early for this test"
     );
-    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert_eq!(second.status.code(), Some(4), "{}", stderr(&second));
     assert!(
         stderr(&second).contains("another sweep"),
         "{}",
@@ -382,7 +382,7 @@ fn a_second_sweep_into_a_busy_directory_is_refused() {
     );
     assert_eq!(
         resumed.status.code(),
-        Some(2),
+        Some(4),
         "a shard of another list is refused"
     );
     assert!(
@@ -412,7 +412,7 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     assert!(sweep(dir, &other, &["--shard", "2/2"]).status.success());
 
     let foreign = run_in(dir, &["merge", "p1", "q2", "--out", "m1", "--no-report"]);
-    assert_eq!(foreign.status.code(), Some(2));
+    assert_eq!(foreign.status.code(), Some(3));
     assert!(
         stderr(&foreign).contains("not parts of the same sweep"),
         "{}",
@@ -421,21 +421,21 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     assert!(stderr(&foreign).contains("seed"), "{}", stderr(&foreign));
 
     let missing = run_in(dir, &["merge", "p1", "--out", "m2", "--no-report"]);
-    assert_eq!(missing.status.code(), Some(2));
+    assert_eq!(missing.status.code(), Some(3));
     assert!(stderr(&missing).contains("missing"), "{}", stderr(&missing));
 
     let dup = run_in(
         dir,
         &["merge", "p1", "p2", "p2", "--out", "m3", "--no-report"],
     );
-    assert_eq!(dup.status.code(), Some(2));
+    assert_eq!(dup.status.code(), Some(3));
     assert!(stderr(&dup).contains("is in both"), "{}", stderr(&dup));
 
     // Shards cut with another --shard count are named as such, not as a duplicated run.
     let args = sweep_args(&mesh, "r3", 3, "1..2");
     assert!(sweep(dir, &args, &["--shard", "2/3"]).status.success());
     let counts = run_in(dir, &["merge", "p1", "r3", "--out", "m6", "--no-report"]);
-    assert_eq!(counts.status.code(), Some(2));
+    assert_eq!(counts.status.code(), Some(3));
     assert!(
         stderr(&counts).contains("is shard 1/2 but") && stderr(&counts).contains("shard 2/3"),
         "{}",
@@ -443,7 +443,7 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     );
 
     let nodir = run_in(dir, &["merge", "p1", "nodir", "--out", "m5", "--no-report"]);
-    assert_eq!(nodir.status.code(), Some(2));
+    assert_eq!(nodir.status.code(), Some(3));
     assert!(
         stderr(&nodir).contains("nodir: no such results directory"),
         "{}",
@@ -455,7 +455,7 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
     assert!(ok.status.success(), "{}", stderr(&ok));
     // Merging into a directory that holds runs is refused, with advice merge can follow.
     let again = run_in(dir, &["merge", "p1", "p2", "--out", "m4", "--no-report"]);
-    assert_eq!(again.status.code(), Some(2));
+    assert_eq!(again.status.code(), Some(4));
     assert!(
         stderr(&again).contains("choose another --out"),
         "{}",
@@ -510,15 +510,15 @@ fn statistics_match_textbook_values() {
     assert_eq!(b.outliers, vec![30.0]);
 }
 
-/// Arguments a sweep cannot follow are refused up front with exit code 2 and one clear line:
-/// baselines asked for with zero runs, an `--out` that is a file, a missing mesh (its cause
-/// said once).
+/// Arguments a sweep cannot follow are refused up front with one clear line and the exit
+/// code of their kind: baselines asked for with zero runs (usage, 2), a missing mesh (bad
+/// input, 3; its cause said once), an `--out` that is a file (results directory, 4).
 #[test]
 fn sweep_refuses_arguments_it_cannot_follow() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     std::fs::write(dir.join("afile"), "").unwrap();
-    for (args, expect) in [
+    for (args, expect, code) in [
         (
             &[
                 "--mesh",
@@ -531,6 +531,7 @@ fn sweep_refuses_arguments_it_cannot_follow() {
                 "a",
             ][..],
             "--baseline-runs must be at least 1 (it is the number of runs of greedy)",
+            2,
         ),
         (
             &[
@@ -543,18 +544,20 @@ fn sweep_refuses_arguments_it_cannot_follow() {
                 "--out",
                 "afile",
             ][..],
-            "--out afile: exists and is not a directory",
+            "--out afile: is a regular file, not a directory",
+            4,
         ),
         (
             &["--mesh", "nosuch.msh", "--out", "b"][..],
             "nosuch.msh: No such file",
+            3,
         ),
     ] {
         let mut all = vec!["sweep", "--backend", "cpu", "--quiet"];
         all.extend_from_slice(args);
         let out = run_in(dir, &all);
         let err = stderr(&out);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
         assert!(err.contains(expect), "{args:?}: {err}");
         assert!(
             err.matches("No such file").count() <= 1,

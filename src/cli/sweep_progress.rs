@@ -1,6 +1,7 @@
-//! Progress on stderr: an indicatif bar with ETA on a terminal, plain lines every few seconds
-//! otherwise (logs of cluster jobs and CI), printed by a ticker thread so that long runs still
-//! show the sweep is alive.
+//! A sweep's progress on stderr: an indicatif bar with ETA on a terminal, plain lines every
+//! few seconds otherwise (logs of cluster jobs and CI), printed by a ticker thread so that long
+//! runs still show the sweep is alive. Driven by the sweep's events ([`SweepDisplay::event`]), with
+//! its notices (backend chosen, resume).
 
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -9,6 +10,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use quadrecomb::experiment::events::Event;
 
 /// How progress is shown.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -19,6 +21,63 @@ pub enum ProgressMode {
     Plain,
     /// Nothing.
     Quiet,
+}
+
+/// Shows what a sweep reports: the backend chosen (always), the resume notice and the
+/// progress (as `mode` says).
+#[derive(Debug)]
+pub struct SweepDisplay {
+    mode: ProgressMode,
+    progress: Option<Progress>,
+}
+
+impl SweepDisplay {
+    /// Shows nothing until the sweep reports.
+    pub fn new(mode: ProgressMode) -> SweepDisplay {
+        SweepDisplay {
+            mode,
+            progress: None,
+        }
+    }
+
+    /// Shows one event.
+    pub fn event(&mut self, event: Event<'_>) {
+        match event {
+            Event::Backend(note) => eprintln!("quality backend: {note}"),
+            Event::Resuming {
+                recorded,
+                planned,
+                torn,
+            } => {
+                if self.mode != ProgressMode::Quiet {
+                    eprintln!("{}", resuming_line(recorded, planned, torn));
+                }
+            }
+            Event::Started { runs } => self.progress = Some(Progress::new(self.mode, runs)),
+            Event::RunDone => {
+                if let Some(p) = &self.progress {
+                    p.inc();
+                }
+            }
+            Event::Finished => {
+                if let Some(mut p) = self.progress.take() {
+                    p.finish();
+                }
+            }
+        }
+    }
+}
+
+/// The notice of a resumed sweep.
+fn resuming_line(recorded: usize, planned: usize, torn: bool) -> String {
+    format!(
+        "sweep: resuming: {recorded} of {planned} runs already recorded{}",
+        if torn {
+            " (a torn last line was dropped and will be redone)"
+        } else {
+            ""
+        }
+    )
 }
 
 /// Time between two plain progress lines.
@@ -100,7 +159,8 @@ impl Progress {
     }
 
     /// The current plain line, e.g. "sweep: 340/1283 runs (26.5%), 12.3 s elapsed, ETA 34 s".
-    pub fn line(&self) -> String {
+    #[cfg(test)]
+    fn line(&self) -> String {
         line(&self.shared)
     }
 
@@ -167,5 +227,22 @@ mod tests {
             p.line()
         );
         assert!(p.line().contains("ETA "));
+    }
+
+    #[test]
+    fn events_drive_the_display() {
+        assert_eq!(
+            resuming_line(9, 40, true),
+            "sweep: resuming: 9 of 40 runs already recorded (a torn last line was dropped \
+             and will be redone)"
+        );
+        let mut d = SweepDisplay::new(ProgressMode::Quiet);
+        d.event(Event::Started { runs: 3 });
+        d.event(Event::RunDone);
+        d.event(Event::RunDone);
+        let line = d.progress.as_ref().unwrap().line();
+        assert!(line.starts_with("sweep: 2/3 runs"), "{line}");
+        d.event(Event::Finished);
+        assert!(d.progress.is_none());
     }
 }

@@ -1,0 +1,187 @@
+//! Errors at the command line's edge: the exit code of an error, and its message, where a
+//! library error that names a value is worded with the flag that sets it.
+//!
+//! | code | meaning |
+//! |------|---------|
+//! | 0 | success |
+//! | 1 | any other failure (a file the system cannot read or write, no GPU, a bug) |
+//! | 2 | usage error: an unknown flag or a value it refuses (clap), a value out of range |
+//! | 3 | bad input: a mesh file unreadable or invalid, a results directory whose files are corrupt or do not form one sweep |
+//! | 4 | the results directory cannot be used: it holds other runs or another configuration, another sweep is writing it, or it is not a directory |
+//! | 5 | out of memory ([`super::oom`]) |
+//! | 130 | interrupted (Ctrl-C) |
+
+use std::error::Error;
+
+use quadrecomb::experiment::ExperimentError;
+use quadrecomb::gpu::GpuError;
+use quadrecomb::report::ReportError;
+
+use super::BadInput;
+
+/// Any other failure.
+pub const EXIT_FAILURE: u8 = 1;
+/// A usage error (clap's own code for its errors).
+pub const EXIT_USAGE: u8 = 2;
+/// An input file (mesh, results) is unreadable or invalid.
+pub const EXIT_BAD_INPUT: u8 = 3;
+/// The results directory cannot be used as asked.
+pub const EXIT_RESULTS_DIR: u8 = 4;
+/// Out of memory.
+pub const EXIT_OUT_OF_MEMORY: u8 = 5;
+/// Interrupted by Ctrl-C (128 + SIGINT, as shells report it).
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// The exit code of an error: that of the outermost cause that has one, else
+/// [`EXIT_FAILURE`].
+pub fn exit_code(err: &anyhow::Error) -> u8 {
+    err.chain().find_map(code).unwrap_or(EXIT_FAILURE)
+}
+
+/// The code one cause decides, if it decides one.
+fn code(e: &(dyn Error + 'static)) -> Option<u8> {
+    if e.is::<BadInput>() {
+        return Some(EXIT_USAGE);
+    }
+    if e.is::<quadrecomb::mesh::ReadError>() || e.is::<quadrecomb::mesh::MeshError>() {
+        return Some(EXIT_BAD_INPUT);
+    }
+    if let Some(e) = e.downcast_ref::<ExperimentError>() {
+        return experiment_code(e);
+    }
+    match e.downcast_ref::<ReportError>()? {
+        ReportError::NotResults { .. } | ReportError::NoRuns { .. } => Some(EXIT_BAD_INPUT),
+        ReportError::NoSuchPicture(..) => Some(EXIT_USAGE),
+        // Transparent: the inner error is not in the chain.
+        ReportError::Results(inner) => experiment_code(inner),
+        _ => None,
+    }
+}
+
+fn experiment_code(e: &ExperimentError) -> Option<u8> {
+    use ExperimentError as E;
+    match e {
+        E::Invalid(_) => Some(EXIT_USAGE),
+        E::Corrupt { .. }
+        | E::Mesh { .. }
+        | E::ForeignRecords { .. }
+        | E::Merge(_)
+        | E::TornPart { .. }
+        | E::OptimumContradicted { .. } => Some(EXIT_BAD_INPUT),
+        E::Mismatch { .. }
+        | E::AlreadyExists { .. }
+        | E::MergeTargetNotEmpty { .. }
+        | E::NotADirectory { .. }
+        | E::Busy { .. } => Some(EXIT_RESULTS_DIR),
+        // I/O, GPU and run failures: decided by their cause, else a failure.
+        _ => None,
+    }
+}
+
+/// The error and its causes on one line, `a: b: c`, skipping a cause whose message its parent
+/// already ends with (typed errors often print their source in their own message too).
+pub fn describe(err: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in err.chain() {
+        let msg = flag_wording(cause).unwrap_or_else(|| cause.to_string());
+        if out.ends_with(&msg) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&msg);
+    }
+    out
+}
+
+/// A library error's message with the flags that fix it, where its own names only values.
+fn flag_wording(e: &(dyn Error + 'static)) -> Option<String> {
+    if let Some(GpuError::NoAdapter) = e.downcast_ref::<GpuError>() {
+        return Some(
+            "no Vulkan adapter found (install a GPU driver or lavapipe, Debian package \
+             mesa-vulkan-drivers, or use --backend cpu)"
+                .into(),
+        );
+    }
+    use ExperimentError as E;
+    Some(match e.downcast_ref::<ExperimentError>()? {
+        e @ E::AlreadyExists { .. } => format!(
+            "{e}; pass --resume to continue that sweep, --overwrite to replace it, or choose \
+             another --out"
+        ),
+        e @ E::MergeTargetNotEmpty { .. } => {
+            format!("{e}: choose another --out or remove that one")
+        }
+        e @ E::Busy { .. } => format!("{e}; wait for it, stop it, or choose another --out"),
+        E::NotADirectory { dir, kind } => format!(
+            "--out {}: is {kind}, not a directory (results go into a directory)",
+            dir.display()
+        ),
+        E::TornPart { path } => format!(
+            "{} ends with a torn line (the sweep was interrupted): run `quadrecomb sweep \
+             --resume` there first",
+            path.display()
+        ),
+        E::OptimumContradicted { run, why } => format!(
+            "run {run}: {why}: the optimum recorded for its mesh is wrong (an edited optimum \
+             cache?); run again with --overwrite"
+        ),
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    fn code_of(e: ExperimentError) -> u8 {
+        exit_code(&anyhow::Error::new(e).context("running the sweep"))
+    }
+
+    #[test]
+    fn each_kind_of_error_has_its_code() {
+        let dir = PathBuf::from("d");
+        assert_eq!(code_of(ExperimentError::Invalid("x".into())), EXIT_USAGE);
+        assert_eq!(code_of(ExperimentError::Merge("x".into())), EXIT_BAD_INPUT);
+        assert_eq!(
+            code_of(ExperimentError::Busy {
+                dir: dir.clone(),
+                pid: None
+            }),
+            EXIT_RESULTS_DIR
+        );
+        assert_eq!(code_of(ExperimentError::Run("x".into())), EXIT_FAILURE);
+        assert_eq!(
+            code_of(ExperimentError::Io {
+                path: dir.clone(),
+                source: std::io::Error::other("x")
+            }),
+            EXIT_FAILURE
+        );
+        let report = ReportError::Results(ExperimentError::AlreadyExists { dir, records: 1 });
+        assert_eq!(exit_code(&report.into()), EXIT_RESULTS_DIR);
+        assert_eq!(exit_code(&BadInput("x".into()).into()), EXIT_USAGE);
+    }
+
+    #[test]
+    fn library_errors_are_worded_with_flags() {
+        let e = anyhow::Error::new(ExperimentError::AlreadyExists {
+            dir: PathBuf::from("d"),
+            records: 3,
+        });
+        assert_eq!(
+            describe(&e),
+            "d: already holds 3 run(s) of a sweep; pass --resume to continue that sweep, \
+             --overwrite to replace it, or choose another --out"
+        );
+        let e = anyhow::Error::new(ExperimentError::Gpu(GpuError::NoAdapter));
+        assert!(
+            describe(&e).starts_with("computing quad qualities: no Vulkan adapter found")
+                && describe(&e).ends_with("or use --backend cpu)"),
+            "{}",
+            describe(&e)
+        );
+    }
+}
