@@ -14,6 +14,7 @@ pub mod merge;
 pub mod plan;
 pub mod progress;
 pub mod record;
+pub mod replay;
 pub mod seed;
 pub mod store;
 pub mod summary;

@@ -20,6 +20,7 @@ pub mod typical;
 pub use document::{Block, Document};
 pub use results::{Config, Metric, Results, Run};
 
+use crate::experiment::replay::Replayer;
 use crate::stats::describe::{BoxStats, median};
 use format::{fmt_opt, fmt_sig};
 use plots::{Extras, HorizonBox, boxplot_svg};
@@ -160,7 +161,7 @@ pub fn build(
     let mut doc = Document::default();
     doc.heading(1, format!("quadrecomb report: {}", results.dir.display()));
     overview(&mut doc, results);
-    let mut rerunner = typical::Rerunner::default();
+    let mut replayer = Replayer::new(&results.dir, results.manifest.as_ref());
     for (i, mesh) in results.meshes.iter().enumerate() {
         mesh_section(
             &mut doc,
@@ -168,7 +169,7 @@ pub fn build(
             mesh,
             opts,
             opts.seed.wrapping_add(100_000 * i as u64),
-            &mut rerunner,
+            &mut replayer,
         )?;
     }
     if let Some(other) = other {
@@ -299,7 +300,7 @@ fn mesh_section(
     mesh: &str,
     opts: &ReportOptions,
     seed: u64,
-    rerunner: &mut typical::Rerunner,
+    replayer: &mut Replayer<'_>,
 ) -> Result<(), ReportError> {
     let configs: Vec<(&Config, &[Run])> = results.configs_of(mesh).collect();
     let first = &configs[0].1[0];
@@ -363,7 +364,7 @@ fn mesh_section(
     paper_beside(doc, mesh, &configs);
     box_plots(doc, mesh, &configs)?;
     if opts.pictures {
-        pictures(doc, results, mesh, &configs, opts, rerunner)?;
+        pictures(doc, mesh, &configs, opts, replayer)?;
     }
 
     doc.heading(3, "Statistical comparisons");
@@ -651,11 +652,10 @@ fn picture_choice<'a>(
 /// Pictures of typical (median-quality) runs, re-run from their seeds.
 fn pictures(
     doc: &mut Document,
-    results: &Results,
     mesh: &str,
     configs: &[(&Config, &[Run])],
     opts: &ReportOptions,
-    rerunner: &mut typical::Rerunner,
+    replayer: &mut Replayer<'_>,
 ) -> Result<(), ReportError> {
     let chosen = picture_choice(configs, opts);
     if chosen.is_empty() {
@@ -669,7 +669,7 @@ fn pictures(
         let Some(run) = typical::median_run(runs) else {
             continue;
         };
-        let t = match rerunner.rerun(results, run) {
+        let t = match typical::rerun(replayer, run) {
             Ok(t) => t,
             Err(why) => {
                 doc.para(format!("No picture of {mesh} {}: {why}.", c.label()));
