@@ -7,6 +7,7 @@ mod memory;
 mod meshes;
 mod model;
 mod optimum;
+mod replay;
 mod report;
 mod results;
 mod runner;
