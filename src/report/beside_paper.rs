@@ -2,12 +2,17 @@
 //! case for ([`super::paper`]).
 
 use super::format::{fmt_opt, fmt_sig};
-use super::mesh_section::median_opt;
+use super::summarized::{median_of, metric_median};
 use super::{Config, Document, Metric, Run, paper};
-use crate::stats::describe::median;
+use crate::experiment::summary::Summary;
 
 /// The paper's numbers beside ours, for meshes the paper has a case for.
-pub(super) fn paper_beside(doc: &mut Document, mesh: &str, configs: &[(&Config, &[Run])]) {
+pub(super) fn paper_beside(
+    doc: &mut Document,
+    summary: &Summary,
+    mesh: &str,
+    configs: &[(&Config, &[Run])],
+) {
     let Some(case) = paper::case_for(mesh) else {
         return;
     };
@@ -23,15 +28,15 @@ pub(super) fn paper_beside(doc: &mut Document, mesh: &str, configs: &[(&Config, 
         configs
             .iter()
             .find(|(c, _)| c.algo == algo && c.horizon == h)
-            .map(|(_, r)| *r)
+            .map(|(c, r)| (*c, *r))
     };
     let mut rows = Vec::new();
     for p in case.rows {
         let ours = find(p.algo, p.horizon);
         let ours_med = |m: Metric| {
-            ours.and_then(|r| match m {
-                Metric::Quality => median_opt(r, |x| x.quality_pct),
-                _ => Some(median(&m.values(r))),
+            ours.and_then(|(c, r)| match m {
+                Metric::Quality => median_of(summary, c, |g| g.quality_pct.as_ref()),
+                _ => Some(metric_median(summary, c, r, m)),
             })
         };
         rows.push(vec![

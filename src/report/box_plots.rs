@@ -4,12 +4,14 @@
 use super::format::{mesh_slug, slug};
 use super::mesh_section::tree_algos;
 use super::plots::{Extras, HorizonBox, boxplot_svg};
+use super::summarized::{growth, metric_median, metric_stats};
 use super::{Config, Document, FIGURES_DIR, Metric, ReportError, Run};
-use crate::stats::describe::{BoxStats, median};
+use crate::experiment::summary::Summary;
 
 /// Fig.-8-style box plots for each algorithm with horizons.
 pub(super) fn box_plots(
     doc: &mut Document,
+    summary: &Summary,
     mesh: &str,
     configs: &[(&Config, &[Run])],
 ) -> Result<(), ReportError> {
@@ -20,18 +22,22 @@ pub(super) fn box_plots(
     doc.heading(3, "Box plots against horizon");
     let greedy = configs.iter().find(|(c, _)| c.algo == "greedy");
     for algo in algos {
-        let group: Vec<(u32, &[Run])> = configs
+        let group: Vec<(&Config, u32, &[Run])> = configs
             .iter()
             .filter(|(c, _)| c.algo == algo)
-            .filter_map(|(c, r)| c.horizon.map(|h| (h, *r)))
+            .filter_map(|(c, r)| c.horizon.map(|h| (*c, h, *r)))
             .collect();
         for metric in Metric::ALL {
-            let all: Vec<Run> = group.iter().flat_map(|(_, r)| r.iter().cloned()).collect();
+            let all: Vec<Run> = group
+                .iter()
+                .flat_map(|(_, _, r)| r.iter().cloned())
+                .collect();
             let name = metric.name(&all);
             let boxes: Vec<HorizonBox> = group
                 .iter()
-                .filter_map(|(h, r)| {
-                    BoxStats::of(&metric.values(r)).map(|stats| HorizonBox { horizon: *h, stats })
+                .filter_map(|(c, h, r)| {
+                    let stats = metric_stats(summary, c, r, metric)?;
+                    Some(HorizonBox { horizon: *h, stats })
                 })
                 .collect();
             let mut extras = Extras::default();
@@ -39,21 +45,20 @@ pub(super) fn box_plots(
                 if metric.name(gr) == name {
                     extras
                         .baselines
-                        .push((g.label(), median(&metric.values(gr))));
+                        .push((g.label(), metric_median(summary, g, gr, metric)));
                 }
             }
             let mut caption = format!(
                 "{mesh}, {algo}: {name} against horizon ({} runs per horizon). Red lines: medians; \
                  blue boxes: interquartile ranges; whiskers: most extreme runs within 1.5 IQR; \
                  red crosses: outliers.",
-                group.iter().map(|(_, r)| r.len()).max().unwrap_or(0)
+                group.iter().map(|(_, _, r)| r.len()).max().unwrap_or(0)
             );
             let log_y = metric == Metric::Time;
             if log_y {
                 // The runner's growth fits (as in summary.json): log10(median time) on h over
                 // every horizon, and over the upper half where the paper reads alpha.
-                let growth = crate::experiment::summary::summarize(&all).growth;
-                let entry = growth.iter().find(|g| g.algo == algo);
+                let entry = growth(summary, mesh, algo);
                 extras.fit = entry.and_then(|g| g.upper.clone().or_else(|| g.all.clone()));
                 caption.push_str(" Logarithmic axis.");
                 if let Some(f) = &extras.fit {

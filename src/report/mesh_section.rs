@@ -4,8 +4,10 @@
 
 use super::format::{fmt_opt, fmt_sig};
 use super::significance::{self, Family};
+use super::summarized::{median_of, metric_median};
 use super::{Config, Document, Metric, ReportError, ReportOptions, Results, Run, results};
 use crate::experiment::replay::Replayer;
+use crate::experiment::summary::Summary;
 use crate::stats::describe::median;
 
 /// The optimum quality of `mesh` from the manifest, if recorded.
@@ -19,15 +21,10 @@ pub(super) fn optimum_of(results: &Results, mesh: &str) -> Option<f64> {
         .map(|o| o.quality)
 }
 
-/// Median of an optional field over runs, when every run has it.
-pub(super) fn median_opt(runs: &[Run], f: impl Fn(&Run) -> Option<f64>) -> Option<f64> {
-    let v: Option<Vec<f64>> = runs.iter().map(f).collect();
-    v.filter(|v| !v.is_empty()).map(|v| median(&v))
-}
-
 pub(super) fn mesh_section(
     doc: &mut Document,
     results: &Results,
+    summary: &Summary,
     mesh: &str,
     opts: &ReportOptions,
     seed: u64,
@@ -53,14 +50,14 @@ pub(super) fn mesh_section(
                 c.algo.clone(),
                 c.horizon.map_or("–".into(), |h| h.to_string()),
                 runs.len().to_string(),
-                fmt_opt(median_opt(runs, |r| r.quality_pct), 2),
-                format!("{:.2}", median(&Metric::Recombined.values(runs))),
-                fmt_sig(median(&Metric::Time.values(runs)), 3),
+                fmt_opt(median_of(summary, c, |g| g.quality_pct.as_ref()), 2),
+                format!("{:.2}", metric_median(summary, c, runs, Metric::Recombined)),
+                fmt_sig(metric_median(summary, c, runs, Metric::Time), 3),
                 fmt_sig(
                     median(&runs.iter().map(results::nodes_per_tree).collect::<Vec<_>>()),
                     3,
                 ),
-                fmt_opt(median_opt(runs, |r| r.branching_factor), 3),
+                fmt_opt(median_of(summary, c, |g| g.branching_factor.as_ref()), 3),
             ]
         })
         .collect();
@@ -91,9 +88,9 @@ pub(super) fn mesh_section(
          decisions are unchanged), and its time grows more slowly with the horizon.",
     );
 
-    element_table(doc, &configs);
-    super::beside_paper::paper_beside(doc, mesh, &configs);
-    super::box_plots::box_plots(doc, mesh, &configs)?;
+    element_table(doc, summary, &configs);
+    super::beside_paper::paper_beside(doc, summary, mesh, &configs);
+    super::box_plots::box_plots(doc, summary, mesh, &configs)?;
     if opts.pictures {
         super::pictures::pictures(doc, mesh, &configs, opts, replayer)?;
     }
@@ -110,22 +107,21 @@ pub(super) fn mesh_section(
 
 /// The element quality of each configuration beside its sum: a high sum with many
 /// triangles left, or with near-degenerate quads, is not a better mesh.
-pub(super) fn element_table(doc: &mut Document, configs: &[(&Config, &[Run])]) {
+pub(super) fn element_table(doc: &mut Document, summary: &Summary, configs: &[(&Config, &[Run])]) {
     if configs.iter().all(|(_, runs)| runs[0].mean_eta.is_none()) {
         return;
     }
     doc.heading(3, "Element quality (medians)");
-    let count = |f: fn(&Run) -> Option<usize>| move |r: &Run| f(r).map(|n| n as f64);
     let rows: Vec<Vec<String>> = configs
         .iter()
         .map(|(c, runs)| {
             vec![
                 c.algo.clone(),
                 c.horizon.map_or("–".into(), |h| h.to_string()),
-                fmt_opt(median_opt(runs, |r| r.mean_eta), 4),
-                fmt_opt(median_opt(runs, |r| r.worst_eta), 4),
-                fmt_opt(median_opt(runs, count(|r| r.quads_eta_below_0_1)), 1),
-                fmt_opt(median_opt(runs, count(|r| r.quads_eta_below_0_3)), 1),
+                fmt_opt(median_of(summary, c, |g| g.mean_eta.as_ref()), 4),
+                fmt_opt(median_of(summary, c, |g| g.worst_eta.as_ref()), 4),
+                fmt_opt(median_of(summary, c, |g| g.quads_eta_below_0_1.as_ref()), 1),
+                fmt_opt(median_of(summary, c, |g| g.quads_eta_below_0_3.as_ref()), 1),
                 format!(
                     "{}",
                     median(

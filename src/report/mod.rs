@@ -22,6 +22,7 @@ mod pictures;
 pub mod plots;
 pub mod results;
 pub mod significance;
+mod summarized;
 pub mod typical;
 
 pub use document::{Block, Document};
@@ -111,12 +112,12 @@ pub use crate::experiment::engine::FIGURES_DIR;
 pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportError> {
     let results = Results::read(dir)?;
     // The summary follows the runs it is made of (it was left stale after an edit).
-    crate::experiment::summary::write(dir, &results.runs())?;
+    let summary = crate::experiment::summary::write(dir, &results.runs())?;
     let other = match &opts.compare {
         Some(d) => Some(Results::read(d)?),
         None => None,
     };
-    let doc = build(&results, other.as_ref(), opts)?;
+    let doc = build(&results, &summary, other.as_ref(), opts)?;
     let fig_dir = dir.join(FIGURES_DIR);
     let io = |path: &Path| {
         let path = path.to_path_buf();
@@ -154,9 +155,12 @@ pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportErro
     })
 }
 
-/// Builds the report of `results` (compared with `other` if given) without writing anything.
+/// Builds the report of `results`, whose summary is `summary`
+/// ([`crate::experiment::summary::summarize`] of its runs), compared with `other` if given,
+/// without writing anything.
 pub fn build(
     results: &Results,
+    summary: &crate::experiment::summary::Summary,
     other: Option<&Results>,
     opts: &ReportOptions,
 ) -> Result<Document, ReportError> {
@@ -169,6 +173,7 @@ pub fn build(
         mesh_section::mesh_section(
             &mut doc,
             results,
+            summary,
             mesh,
             opts,
             opts.seed.wrapping_add(100_000 * i as u64),
