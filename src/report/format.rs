@@ -45,22 +45,6 @@ pub fn fmt_opt(v: Option<f64>, decimals: usize) -> String {
     v.map_or("–".to_string(), |v| format!("{v:.decimals$}"))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn formats() {
-        assert_eq!(fmt_sig(0.012345, 3), "0.0123");
-        assert_eq!(fmt_sig(225.6, 3), "226");
-        assert_eq!(fmt_sig(1.5, 3), "1.50");
-        assert_eq!(fmt_metric(Metric::Quality, 1.234, true), "+1.23");
-        assert_eq!(fmt_metric(Metric::Quality, -1.234, true), "-1.23");
-        assert_eq!(fmt_p(0.0123), "0.012");
-        assert_eq!(fmt_p(2.3e-11), "2.30e-11");
-    }
-}
-
 /// File-name-safe form of a mesh name: its [`slug`] when that is the name itself, else the
 /// slug and 8 hex digits of the name's hash (`a b` and `a-b` both gave `a-b`, and their
 /// figures overwrote each other).
@@ -89,4 +73,20 @@ pub(super) fn slug(s: &str) -> String {
         .filter(|p| !p.is_empty())
         .collect::<Vec<_>>()
         .join("-")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats() {
+        assert_eq!(fmt_sig(0.012345, 3), "0.0123");
+        assert_eq!(fmt_sig(225.6, 3), "226");
+        assert_eq!(fmt_sig(1.5, 3), "1.50");
+        assert_eq!(fmt_metric(Metric::Quality, 1.234, true), "+1.23");
+        assert_eq!(fmt_metric(Metric::Quality, -1.234, true), "-1.23");
+        assert_eq!(fmt_p(0.0123), "0.012");
+        assert_eq!(fmt_p(2.3e-11), "2.30e-11");
+    }
 }

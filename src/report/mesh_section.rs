@@ -21,6 +21,24 @@ pub(super) fn optimum_of(results: &Results, mesh: &str) -> Option<f64> {
         .map(|o| o.quality)
 }
 
+/// One table row per configuration: its algorithm and horizon ("–" for none), then the
+/// `cells` of its runs.
+fn config_rows(
+    configs: &[(&Config, &[Run])],
+    cells: impl Fn(&Config, &[Run]) -> Vec<String>,
+) -> Vec<Vec<String>> {
+    (configs.iter())
+        .map(|(c, runs)| {
+            let mut row = vec![
+                c.algo.clone(),
+                c.horizon.map_or("–".into(), |h| h.to_string()),
+            ];
+            row.extend(cells(c, runs));
+            row
+        })
+        .collect()
+}
+
 pub(super) fn mesh_section(
     doc: &mut Document,
     results: &Results,
@@ -31,6 +49,7 @@ pub(super) fn mesh_section(
     replayer: &mut Replayer<'_>,
 ) -> Result<(), ReportError> {
     let configs: Vec<(&Config, &[Run])> = results.configs_of(mesh).collect();
+    let configs = configs.as_slice();
     let first = &configs[0].1[0];
     doc.heading(2, format!("Mesh {mesh}"));
     let opt = optimum_of(results, mesh);
@@ -43,24 +62,19 @@ pub(super) fn mesh_section(
 
     // Table 1.
     doc.heading(3, "Results (medians)");
-    let rows: Vec<Vec<String>> = configs
-        .iter()
-        .map(|(c, runs)| {
-            vec![
-                c.algo.clone(),
-                c.horizon.map_or("–".into(), |h| h.to_string()),
-                runs.len().to_string(),
-                fmt_opt(median_of(summary, c, |g| g.quality_pct.as_ref()), 2),
-                format!("{:.2}", metric_median(summary, c, runs, Metric::Recombined)),
-                fmt_sig(metric_median(summary, c, runs, Metric::Time), 3),
-                fmt_sig(
-                    median(&runs.iter().map(results::nodes_per_tree).collect::<Vec<_>>()),
-                    3,
-                ),
-                fmt_opt(median_of(summary, c, |g| g.branching_factor.as_ref()), 3),
-            ]
-        })
-        .collect();
+    let rows = config_rows(configs, |c, runs| {
+        vec![
+            runs.len().to_string(),
+            fmt_opt(median_of(summary, c, |g| g.quality_pct.as_ref()), 2),
+            format!("{:.2}", metric_median(summary, c, runs, Metric::Recombined)),
+            fmt_sig(metric_median(summary, c, runs, Metric::Time), 3),
+            fmt_sig(
+                median(&runs.iter().map(results::nodes_per_tree).collect::<Vec<_>>()),
+                3,
+            ),
+            fmt_opt(median_of(summary, c, |g| g.branching_factor.as_ref()), 3),
+        ]
+    });
     doc.table(
         [
             "algorithm",
@@ -112,28 +126,23 @@ pub(super) fn element_table(doc: &mut Document, summary: &Summary, configs: &[(&
         return;
     }
     doc.heading(3, "Element quality (medians)");
-    let rows: Vec<Vec<String>> = configs
-        .iter()
-        .map(|(c, runs)| {
-            vec![
-                c.algo.clone(),
-                c.horizon.map_or("–".into(), |h| h.to_string()),
-                fmt_opt(median_of(summary, c, |g| g.mean_eta.as_ref()), 4),
-                fmt_opt(median_of(summary, c, |g| g.worst_eta.as_ref()), 4),
-                fmt_opt(median_of(summary, c, |g| g.quads_eta_below_0_1.as_ref()), 1),
-                fmt_opt(median_of(summary, c, |g| g.quads_eta_below_0_3.as_ref()), 1),
-                format!(
-                    "{}",
-                    median(
-                        &runs
-                            .iter()
-                            .map(|r| r.triangles_left as f64)
-                            .collect::<Vec<_>>()
-                    )
-                ),
-            ]
-        })
-        .collect();
+    let rows = config_rows(configs, |c, runs| {
+        vec![
+            fmt_opt(median_of(summary, c, |g| g.mean_eta.as_ref()), 4),
+            fmt_opt(median_of(summary, c, |g| g.worst_eta.as_ref()), 4),
+            fmt_opt(median_of(summary, c, |g| g.quads_eta_below_0_1.as_ref()), 1),
+            fmt_opt(median_of(summary, c, |g| g.quads_eta_below_0_3.as_ref()), 1),
+            format!(
+                "{}",
+                median(
+                    &runs
+                        .iter()
+                        .map(|r| r.triangles_left as f64)
+                        .collect::<Vec<_>>()
+                )
+            ),
+        ]
+    });
     doc.table(
         [
             "algorithm",

@@ -63,6 +63,12 @@ fn replay(cwd: &Path, dir: &Path, run: &str, r: &RunRecord, extra: &[&str]) -> O
     run_in(cwd, &args)
 }
 
+/// Asserts that `o` failed with exit code `code` and a message that contains `text`.
+fn refused(o: &Output, code: i32, text: &str) {
+    assert_eq!(o.status.code(), Some(code), "{}", stderr(o));
+    assert!(stderr(o).contains(text), "{}", stderr(o));
+}
+
 fn json(o: &Output) -> Value {
     assert!(o.status.success(), "replay: {}", stderr(o));
     serde_json::from_slice(&o.stdout).expect("one JSON object on stdout")
@@ -129,6 +135,22 @@ fn typical_is_the_default_and_is_the_median_run() {
     assert_eq!(v["quads"], sel[1].quads, "{v}");
 }
 
+/// `quadrecomb generate grid` of 200 triangles from `seed` into `dir/m.msh`.
+fn generate_grid(dir: &Path, seed: &str) {
+    let args = [
+        "generate",
+        "grid",
+        "--triangles",
+        "200",
+        "--seed",
+        seed,
+        "-o",
+        "m.msh",
+    ];
+    let o = run_in(dir, &args);
+    assert!(o.status.success(), "generate: {}", stderr(&o));
+}
+
 /// Element counts (triangles, quads) of a mesh file as Gmsh reads it.
 fn gmsh_counts(path: &Path) -> (usize, usize) {
     let script = r#"
@@ -193,20 +215,7 @@ fn replay_exports_the_run_as_msh_and_vtu() {
 fn replay_refuses_what_it_cannot_reproduce() {
     let tmp = tempfile::tempdir().unwrap();
     let t = tmp.path();
-    let o = run_in(
-        t,
-        &[
-            "generate",
-            "grid",
-            "--triangles",
-            "200",
-            "--seed",
-            "7",
-            "-o",
-            "m.msh",
-        ],
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
+    generate_grid(t, "7");
     let dir = sweep(t, "m.msh", "r", &["--backend", "cpu"]);
     let r = records(&dir)
         .into_iter()
@@ -216,25 +225,14 @@ fn replay_refuses_what_it_cannot_reproduce() {
 
     // The output may not be the input mesh.
     let o = replay(t, &dir, "0", &r, &["-o", "m.msh"]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("refusing to overwrite the input"),
-        "{}",
-        stderr(&o)
-    );
+    refused(&o, 2, "refusing to overwrite the input");
     // Nor a file of another kind; and RUN must be an index of the configuration.
     let o = replay(t, &dir, "0", &r, &["-o", "out.stl"]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    refused(&o, 2, "expected a .msh or .vtu file name");
     let o = replay(t, &dir, "7", &r, &[]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("has no run 7 (recorded runs: 0 to 2)"),
-        "{}",
-        stderr(&o)
-    );
+    refused(&o, 2, "has no run 7 (recorded runs: 0 to 2)");
     let o = replay(t, &dir, "first", &r, &[]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("bad RUN \"first\""), "{}", stderr(&o));
+    refused(&o, 2, "bad RUN \"first\"");
 
     // A record the replay does not give (its quality lowered by hand): exit 1, a message
     // with both results, nothing written.
@@ -257,26 +255,8 @@ fn replay_refuses_what_it_cannot_reproduce() {
     std::fs::write(&runs, text).unwrap();
 
     // The mesh changed since the sweep: refused, naming it.
-    let o = run_in(
-        t,
-        &[
-            "generate",
-            "grid",
-            "--triangles",
-            "200",
-            "--seed",
-            "8",
-            "-o",
-            "m.msh",
-        ],
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
+    generate_grid(t, "8");
     let o = replay(t, &dir, "0", &r, &["-o", "out.msh"]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("mesh m.msh has changed since the sweep"),
-        "{}",
-        stderr(&o)
-    );
+    refused(&o, 2, "mesh m.msh has changed since the sweep");
     assert!(!t.join("out.msh").exists());
 }
