@@ -49,7 +49,6 @@ pub(super) fn mesh_section(
     replayer: &mut Replayer<'_>,
 ) -> Result<(), ReportError> {
     let configs: Vec<(&Config, &[Run])> = results.configs_of(mesh).collect();
-    let configs = configs.as_slice();
     let first = &configs[0].1[0];
     doc.heading(2, format!("Mesh {mesh}"));
     let opt = optimum_of(results, mesh);
@@ -62,7 +61,7 @@ pub(super) fn mesh_section(
 
     // Table 1.
     doc.heading(3, "Results (medians)");
-    let rows = config_rows(configs, |c, runs| {
+    let rows = config_rows(&configs, |c, runs| {
         vec![
             runs.len().to_string(),
             fmt_opt(median_of(summary, c, |g| g.quality_pct.as_ref()), 2),
