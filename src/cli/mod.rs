@@ -9,6 +9,7 @@ pub mod oom;
 mod optimum;
 mod progress_bar;
 mod recombine;
+mod replay;
 mod report;
 mod sweep;
 mod sweep_progress;
@@ -41,6 +42,8 @@ enum Command {
     Merge(merge::Args),
     /// Write tables, figures and statistical comparisons for a results directory.
     Report(report::Args),
+    /// Re-run a recorded run of a results directory, check it, and write it as .msh/.vtu.
+    Replay(replay::Args),
     /// Print benchmark figures.
     Bench(bench::Args),
 }
@@ -56,6 +59,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Sweep(args) => sweep::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Report(args) => report::run(args),
+        Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

@@ -1,7 +1,7 @@
 //! `quadrecomb recombine`: one run of one policy on one mesh.
 
 use super::BadInput;
-use quadrecomb::gpu::{Backend, Evaluator};
+use quadrecomb::experiment::replay::{self, EtaSource};
 use quadrecomb::quality::{self, CandidateTable, ElementQuality, Rule};
 use quadrecomb::search::{self, Algo, optimum};
 use std::path::PathBuf;
@@ -71,19 +71,12 @@ pub fn eta_table(
     backend: EtaBackend,
     rule: Rule,
 ) -> anyhow::Result<(CandidateTable, String)> {
-    let ev = match backend {
-        EtaBackend::Exact => {
-            return Ok((
-                CandidateTable::build(mesh).restrict(mesh, rule),
-                "exact".into(),
-            ));
-        }
-        EtaBackend::Cpu => Evaluator::cpu_twin(),
-        EtaBackend::Gpu => Evaluator::new(Backend::Gpu)?,
+    let source = match backend {
+        EtaBackend::Exact => EtaSource::Exact,
+        EtaBackend::Cpu => EtaSource::CpuTwin,
+        EtaBackend::Gpu => EtaSource::Device,
     };
-    let mut table = CandidateTable::topology_only(mesh);
-    ev.fill(&mut [(mesh, &mut table)])?;
-    Ok((table.restrict(mesh, rule), ev.name().to_string()))
+    Ok(replay::eta_table(mesh, source, rule)?)
 }
 
 /// The horizon of a tree policy; `None` for the greedy ones.

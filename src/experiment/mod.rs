@@ -15,6 +15,7 @@ pub mod manifest;
 pub mod merge;
 pub mod plan;
 pub mod record;
+pub mod replay;
 pub mod seed;
 pub mod store;
 pub mod summary;

@@ -1,5 +1,5 @@
 //! A report as a list of blocks, rendered both to Markdown (figures linked as SVG files) and to
-//! a self-contained HTML page (figures inlined).
+//! an HTML page (plots inlined, large mesh pictures shown from their files).
 
 /// One block of a report.
 #[derive(Debug, Clone)]

@@ -45,6 +45,36 @@ pub fn fmt_opt(v: Option<f64>, decimals: usize) -> String {
     v.map_or("–".to_string(), |v| format!("{v:.decimals$}"))
 }
 
+/// File-name-safe form of a mesh name: its [`slug`] when that is the name itself, else the
+/// slug and 8 hex digits of the name's hash (`a b` and `a-b` both gave `a-b`, and their
+/// figures overwrote each other).
+pub(super) fn mesh_slug(mesh: &str) -> String {
+    let s = slug(mesh);
+    if s == mesh {
+        s
+    } else {
+        let h = blake3::hash(mesh.as_bytes()).to_hex();
+        format!("{s}-{}", &h[..8])
+    }
+}
+
+/// File-name-safe form of a label.
+pub(super) fn slug(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
+        .collect::<String>()
+        .split('-')
+        .filter(|p| !p.is_empty())
+        .collect::<Vec<_>>()
+        .join("-")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

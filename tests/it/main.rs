@@ -8,6 +8,7 @@ mod memory;
 mod meshes;
 mod model;
 mod optimum;
+mod replay;
 mod report;
 mod results;
 mod runner;

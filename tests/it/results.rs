@@ -1,6 +1,7 @@
 //! The committed `results/` still match what the code produces: the summary is the statistics
-//! of the committed runs, and a reduced sweep with the same seeds reproduces the committed
-//! records (every field but the wall-clock time).
+//! of the committed runs, a reduced sweep with the same seeds reproduces the committed
+//! records (every field but the wall-clock time), and the report of the committed runs is the
+//! committed report, figures included.
 
 use crate::util::{repo_path, run_in};
 use quadrecomb::experiment::manifest::Manifest;
@@ -116,6 +117,50 @@ fn a_reduced_sweep_reproduces_the_committed_records() {
                 rec.same_result(old),
                 "{rel}: {:?} differs from the committed run:\n{rec:?}\nvs\n{old:?}",
                 rec.key()
+            );
+        }
+    }
+}
+
+/// The committed reports are what `report` writes today from the committed runs and manifest
+/// (golden outputs): report.md, report.html (the directory's name aside) and every figure, byte
+/// for byte. A refactor of the report or of the replay of its typical runs must not change them.
+#[test]
+fn committed_reports_regenerate_unchanged() {
+    for case in [
+        "sphere",
+        "sphere-uniform",
+        "borouchaki",
+        "borouchaki-allow-invalid",
+    ] {
+        let src = repo_path(&format!("results/{case}"));
+        if !src.join("report.md").exists() {
+            continue;
+        }
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().join(case);
+        std::fs::create_dir(&dir).unwrap();
+        for f in ["runs.jsonl", "manifest.json"] {
+            std::fs::copy(src.join(f), dir.join(f)).unwrap();
+        }
+        let paths = quadrecomb::report::write(&dir, &Default::default()).unwrap();
+        let named = |p: &Path| {
+            let text = std::fs::read_to_string(p).unwrap();
+            text.replace(&dir.display().to_string(), &format!("results/{case}"))
+        };
+        for f in ["report.md", "report.html"] {
+            assert!(
+                named(&dir.join(f)) == std::fs::read_to_string(src.join(f)).unwrap(),
+                "results/{case}/{f} is not what report writes now (diff it against `quadrecomb \
+                 report` of a copy)"
+            );
+        }
+        let listed = std::fs::read_to_string(src.join("report-files.txt")).unwrap();
+        assert_eq!(paths.figures.len(), listed.lines().count(), "{case}");
+        for f in listed.lines() {
+            assert!(
+                std::fs::read(dir.join(f)).unwrap() == std::fs::read(src.join(f)).unwrap(),
+                "results/{case}/{f} differs from the figure report draws now"
             );
         }
     }

@@ -1,0 +1,225 @@
+//! `quadrecomb replay DIR [RUN]`: one recorded run of a sweep re-run with the record's mesh,
+//! eta and rule (through [`quadrecomb::experiment::replay`], as the report's pictures), checked
+//! against its record, and optionally written as `.msh` / `.vtu`.
+
+use super::BadInput;
+use quadrecomb::experiment::replay::{self, EtaCheck, Replayer};
+use quadrecomb::report::{Config, Results, Run};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Results directory of a sweep (holding runs.jsonl and manifest.json).
+    dir: PathBuf,
+    /// Which run of the configuration: its run index (the records' `run` field), or
+    /// `typical`, the median run by quality (the run the report pictures).
+    #[arg(default_value = "typical")]
+    run: String,
+    /// Mesh of the configuration (its name in the records; default: the first mesh).
+    #[arg(long)]
+    mesh: Option<String>,
+    /// Algorithm of the configuration (default: the first configuration in the report's
+    /// order: greedy-nocrit, greedy, uniform, selective, optimum).
+    #[arg(long)]
+    algo: Option<String>,
+    /// Horizon of the configuration (default: the smallest recorded).
+    #[arg(long)]
+    horizon: Option<u32>,
+    /// Write the replayed recombination (quads and leftover triangles): .msh (MSH 4.1) or
+    /// .vtu. Written only when the replay reproduces the record.
+    #[arg(short = 'o', long)]
+    output: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Which run: an index or the typical one.
+enum Which {
+    Index(u32),
+    Typical,
+}
+
+fn parse_run(s: &str) -> Result<Which, BadInput> {
+    if s == "typical" {
+        return Ok(Which::Typical);
+    }
+    s.parse().map(Which::Index).map_err(|_| {
+        BadInput(format!(
+            "bad RUN {s:?}: expected a run index (the records' `run` field, e.g. 0) or `typical`"
+        ))
+    })
+}
+
+/// The first configuration of `results` (in report order) that the filters allow.
+fn choose_config<'r>(
+    results: &'r Results,
+    args: &Args,
+) -> Result<(&'r Config, &'r [Run]), BadInput> {
+    let found = results.groups.iter().find(|(c, _)| {
+        args.mesh.as_ref().is_none_or(|m| *m == c.mesh)
+            && args.algo.as_ref().is_none_or(|a| *a == c.algo)
+            && args.horizon.is_none_or(|h| Some(h) == c.horizon)
+    });
+    if let Some((c, runs)) = found {
+        return Ok((c, runs));
+    }
+    let mut asked = Vec::new();
+    asked.extend(args.mesh.as_ref().map(|m| format!("mesh {m}")));
+    asked.extend(args.algo.as_ref().map(|a| format!("algorithm {a}")));
+    asked.extend(args.horizon.map(|h| format!("horizon {h}")));
+    let held: Vec<String> = (results.groups.keys())
+        .map(|c| format!("{} {}", c.mesh, c.label()))
+        .collect();
+    Err(BadInput(format!(
+        "{}: no configuration with {} (it holds: {})",
+        args.dir.display(),
+        asked.join(", "),
+        held.join("; ")
+    )))
+}
+
+/// Sorted run indices as spans: "0 to 99", "0 to 2, 5".
+fn spans(indices: impl Iterator<Item = u32>) -> String {
+    let mut parts: Vec<(u32, u32)> = Vec::new();
+    for i in indices {
+        match parts.last_mut() {
+            Some((_, end)) if end.checked_add(1) == Some(i) => *end = i,
+            _ => parts.push((i, i)),
+        }
+    }
+    let words: Vec<String> = (parts.iter())
+        .map(|&(a, b)| {
+            if a == b {
+                a.to_string()
+            } else {
+                format!("{a} to {b}")
+            }
+        })
+        .collect();
+    words.join(", ")
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let which = parse_run(&args.run)?;
+    super::check_mesh_output(args.output.as_deref())?;
+    let results = Results::read(&args.dir).map_err(|e| BadInput(e.to_string()))?;
+    let (config, runs) = choose_config(&results, &args)?;
+    let record = match which {
+        Which::Typical => replay::typical_run(runs),
+        Which::Index(i) => runs.iter().find(|r| r.run == i),
+    };
+    let Some(record) = record else {
+        return Err(BadInput(format!(
+            "{}: {} {} has no run {} (recorded runs: {})",
+            args.dir.display(),
+            config.mesh,
+            config.label(),
+            args.run,
+            spans(runs.iter().map(|r| r.run))
+        ))
+        .into());
+    };
+    let mut replayer = Replayer::new(&results.dir, results.manifest.as_ref());
+    let cannot = |e: replay::ReplayError| {
+        BadInput(format!(
+            "{}: cannot replay {}: {e}",
+            args.dir.display(),
+            record.key()
+        ))
+    };
+    if let Some(file) = replayer.mesh_file(record).map_err(cannot)? {
+        super::check_not_input(args.output.as_deref(), &file.to_string_lossy())?;
+    }
+    let out = replayer.replay(record).map_err(cannot)?;
+    let write = args.output.as_ref().filter(|_| out.reproduced);
+    if let Some(path) = write {
+        super::write_mesh_output(path, out.mesh, &out.recombined)?;
+    }
+    let typical = matches!(which, Which::Typical);
+    let rule = record.rule();
+    if args.json {
+        let mut v = serde_json::json!({
+            "dir": args.dir,
+            "mesh": record.mesh,
+            "algo": record.algo,
+            "horizon": record.horizon,
+            "run": record.run,
+            "seed": record.seed,
+            "typical": typical,
+            "backend": record.backend,
+            "eta": out.eta,
+            "eta_hash_matches": match out.eta_check {
+                EtaCheck::Matches => Some(true),
+                EtaCheck::NoMatch => Some(false),
+                EtaCheck::Unchecked => None,
+            },
+            "quads": out.quads,
+            "triangles_left": out.triangles_left,
+            "quality": out.quality,
+            "time_s": out.time_s,
+            "recorded": {
+                "quads": record.quads,
+                "triangles_left": record.triangles_left,
+                "quality": record.quality,
+                "quality_pct": record.quality_pct,
+                "time_s": record.time_s,
+            },
+            "reproduced": out.reproduced,
+            "output": write,
+        });
+        super::add_element_fields(&mut v, &out.elements, rule);
+        println!("{v}");
+    } else {
+        println!("results         {}", args.dir.display());
+        let what = if typical {
+            format!(", the typical run (median by quality of {})", runs.len())
+        } else {
+            String::new()
+        };
+        println!(
+            "run             {} (seed {}){what}",
+            record.key(),
+            record.seed
+        );
+        println!("eta             {}", out.eta_note());
+        println!("quads           {} (recorded {})", out.quads, record.quads);
+        println!(
+            "triangles left  {} (recorded {})",
+            out.triangles_left, record.triangles_left
+        );
+        println!(
+            "quality         {:.6} (recorded {:.6})",
+            out.quality, record.quality
+        );
+        super::print_element_lines(&out.elements, rule);
+        println!(
+            "time            {:.4} s (recorded {:.4} s)",
+            out.time_s, record.time_s
+        );
+        let same = if out.reproduced { "yes" } else { "no" };
+        println!("reproduced      {same}");
+        if let Some(p) = write {
+            println!("wrote           {}", p.display());
+        }
+    }
+    if !out.reproduced {
+        anyhow::bail!(
+            "run {} not reproduced: the replay gives {} quads and quality {:.6} where the \
+             record has {} and {:.6} (eta from {}){}",
+            record.key(),
+            out.quads,
+            out.quality,
+            record.quads,
+            record.quality,
+            out.eta_note(),
+            if args.output.is_some() {
+                "; nothing written"
+            } else {
+                ""
+            }
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

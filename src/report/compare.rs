@@ -1,0 +1,80 @@
+//! The comparison section: one results directory against another, configuration by
+//! configuration (`report --compare`).
+
+use super::mesh_section::family_blocks;
+use super::significance::Family;
+use super::{Config, Document, Metric, Results, Run};
+
+/// DIR against DIR2, configuration by configuration.
+pub(super) fn compare_section(doc: &mut Document, a: &Results, b: &Results, seed: u64) {
+    doc.heading(
+        2,
+        format!(
+            "Comparison: {} (first) vs {} (second)",
+            a.dir.display(),
+            b.dir.display()
+        ),
+    );
+    let mut common: Vec<(&Config, &[Run], &[Run])> = Vec::new();
+    let mut only_a = Vec::new();
+    for (c, ra) in &a.groups {
+        match b.groups.get(c) {
+            Some(rb) => common.push((c, ra, rb)),
+            None => only_a.push(format!("{} {}", c.mesh, c.label())),
+        }
+    }
+    let only_b: Vec<String> = b
+        .groups
+        .keys()
+        .filter(|c| !a.groups.contains_key(*c))
+        .map(|c| format!("{} {}", c.mesh, c.label()))
+        .collect();
+    let mut notes = Vec::new();
+    if !only_a.is_empty() {
+        notes.push(format!("Only in the first: {}.", only_a.join(", ")));
+    }
+    if !only_b.is_empty() {
+        notes.push(format!("Only in the second: {}.", only_b.join(", ")));
+    }
+    for (c, ra, rb) in &common {
+        if ra[0].mesh_hash != rb[0].mesh_hash {
+            notes.push(format!(
+                "{}: the two directories used different meshes under the same name (hashes \
+                 differ).",
+                c.mesh
+            ));
+        }
+        if ra[0].backend != rb[0].backend {
+            notes.push(format!(
+                "{} {}: eta came from different backends ({} vs {}).",
+                c.mesh,
+                c.label(),
+                ra[0].backend,
+                rb[0].backend
+            ));
+        }
+    }
+    notes.dedup();
+    doc.list(notes);
+    if common.is_empty() {
+        doc.para("The two directories share no configuration: nothing to compare.");
+        return;
+    }
+    let mut families = Vec::new();
+    for metric in Metric::ALL {
+        let sides: Vec<(String, &[Run], String, &[Run])> = common
+            .iter()
+            .map(|(c, ra, rb)| {
+                let l = format!("{} {}", c.mesh, c.label());
+                (format!("{l} (first)"), *ra, format!("{l} (second)"), *rb)
+            })
+            .collect();
+        families.push(Family::build(
+            format!("First vs second directory, {}", metric.key()),
+            metric,
+            sides,
+            seed.wrapping_add(1000 * metric as u64),
+        ));
+    }
+    family_blocks(doc, &families);
+}

@@ -1,0 +1,72 @@
+//! The report's opening: what was run (runs, configurations, meshes, versions, backends), under
+//! which rule, on which machine and with which seeds.
+
+use super::{Document, Results, Run};
+
+/// Opening paragraph: what was run, where, by which version.
+pub(super) fn overview(doc: &mut Document, results: &Results) {
+    let runs: Vec<&Run> = results.groups.values().flatten().collect();
+    let mut versions: Vec<&str> = runs.iter().map(|r| r.version.as_str()).collect();
+    versions.sort_unstable();
+    versions.dedup();
+    let mut backends: Vec<&str> = runs.iter().map(|r| r.backend.as_str()).collect();
+    backends.sort_unstable();
+    backends.dedup();
+    doc.para(format!(
+        "{} runs in {} configurations on {} mesh(es), made by quadrecomb {} with eta computed by {}.",
+        results.num_runs(),
+        results.groups.len(),
+        results.meshes.len(),
+        versions.join(", "),
+        backends.join(", "),
+    ));
+    let mut rules: Vec<String> = runs.iter().map(|r| r.rule().to_string()).collect();
+    rules.sort_unstable();
+    rules.dedup();
+    doc.para(format!(
+        "Rule: {} (which pairs of triangles may be merged: set by --min-eta and --allow-invalid).",
+        rules.join("; ")
+    ));
+    if let Some(m) = &results.manifest {
+        let machine = |m: &crate::experiment::manifest::Machine| {
+            format!("{} ({} logical cores), {}", m.cpu, m.cores, m.os)
+        };
+        if m.merged_from.is_empty() {
+            doc.para(format!(
+                "Machine: {}; {} worker thread(s). Base seed {}; {} runs per horizon, {} per \
+                 baseline.",
+                machine(&m.machine),
+                m.threads,
+                m.spec.seed,
+                m.spec.runs,
+                m.spec.baseline_runs,
+            ));
+        } else {
+            let parts: Vec<String> = m
+                .merged_from
+                .iter()
+                .map(|p| format!("{} ({} runs): {}", p.dir, p.records, machine(&p.machine)))
+                .collect();
+            doc.para(format!(
+                "Merged from shards run on: {}. Base seed {}.",
+                parts.join("; "),
+                m.spec.seed
+            ));
+        }
+    }
+    if results.torn_bytes > 0 {
+        doc.para(
+            "The last line of runs.jsonl was torn (a run interrupted while being written) and is \
+             not counted; `quadrecomb sweep --resume` redoes it.",
+        );
+    }
+    let labels: Vec<String> = results
+        .groups
+        .iter()
+        .map(|(c, r)| {
+            let runs = if r.len() == 1 { "run" } else { "runs" };
+            format!("{} {} ({} {runs})", c.mesh, c.label(), r.len())
+        })
+        .collect();
+    doc.para(format!("Configurations: {}.", labels.join("; ")));
+}
