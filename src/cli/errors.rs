@@ -43,6 +43,9 @@ fn code(e: &(dyn Error + 'static)) -> Option<u8> {
     if e.is::<BadInput>() {
         return Some(EXIT_USAGE);
     }
+    if e.is::<super::InputError>() {
+        return Some(EXIT_BAD_INPUT);
+    }
     if e.is::<quadrecomb::mesh::ReadError>() || e.is::<quadrecomb::mesh::MeshError>() {
         return Some(EXIT_BAD_INPUT);
     }

@@ -126,6 +126,13 @@ pub fn print_element_lines(
 #[error("{0}")]
 pub struct BadInput(pub String);
 
+/// An input file the command was pointed at that it cannot use (a results directory without
+/// records, a mesh that changed since the sweep), worded by the CLI: exit code 3
+/// ([`errors::EXIT_BAD_INPUT`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct InputError(pub String);
+
 /// Checks before any work that an output path names a `.msh` or `.vtu` file (any case) in
 /// a directory that exists, so that a long run does not end on a path it cannot write.
 pub fn check_mesh_output(path: Option<&std::path::Path>) -> Result<(), BadInput> {

@@ -104,7 +104,7 @@ fn spans(indices: impl Iterator<Item = u32>) -> String {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let which = parse_run(&args.run)?;
     super::check_mesh_output(args.output.as_deref())?;
-    let results = Results::read(&args.dir).map_err(|e| BadInput(e.to_string()))?;
+    let results = Results::read(&args.dir)?;
     let (config, runs) = choose_config(&results, &args)?;
     let record = match which {
         Which::Typical => replay::typical_run(runs),
@@ -123,7 +123,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let mut replayer = Replayer::new(&results.dir, results.manifest.as_ref());
     let cannot = |e: replay::ReplayError| {
-        BadInput(format!(
+        super::InputError(format!(
             "{}: cannot replay {}: {e}",
             args.dir.display(),
             record.key()

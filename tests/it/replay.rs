@@ -257,6 +257,6 @@ fn replay_refuses_what_it_cannot_reproduce() {
     // The mesh changed since the sweep: refused, naming it.
     generate_grid(t, "8");
     let o = replay(t, &dir, "0", &r, &["-o", "out.msh"]);
-    refused(&o, 2, "mesh m.msh has changed since the sweep");
+    refused(&o, 3, "mesh m.msh has changed since the sweep");
     assert!(!t.join("out.msh").exists());
 }
