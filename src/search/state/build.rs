@@ -2,7 +2,11 @@
 //! criterion, the buckets, polders and `P_k` sets, and every initial verdict with its
 //! certificate ([`State::new`]).
 
-use super::*;
+use super::pk::OrderedSets;
+use super::tree::Overlay;
+use super::{CandRecord, State, TriRecord, Verdict};
+use crate::mesh::{Mesh, NONE};
+use crate::quality::CandidateTable;
 
 impl<'a> State<'a> {
     /// The initial state of `mesh` (every triangle remaining) with every verdict computed.

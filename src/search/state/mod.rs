@@ -61,7 +61,7 @@ mod tree;
 mod undo;
 mod verdicts;
 
-use crate::mesh::{Mesh, NONE};
+use crate::mesh::Mesh;
 use crate::quality::CandidateTable;
 pub use oracle::naive_allowed;
 use pk::OrderedSets;

@@ -2,7 +2,9 @@
 //! every verdict against a from-scratch evaluation) and [`naive_allowed`], the criterion
 //! computed by a full search per candidate.
 
-use super::*;
+use super::State;
+use crate::mesh::{Mesh, NONE};
+use crate::quality::CandidateTable;
 
 impl State<'_> {
     /// Checks the state's internal invariants (buckets, counts, polder sizes) and the

@@ -2,7 +2,8 @@
 //! every change as an [`Op`], `undo` reverts the last action in O(1) per change, `reset`
 //! returns to the initial state.
 
-use super::*;
+use super::{DEAD, Initial, KIND_LOCAL, Op, State, is_split};
+use crate::mesh::NONE;
 
 impl State<'_> {
     /// Recombines the two triangles of candidate `c` (both must remain; the criterion is

@@ -2,7 +2,8 @@
 //! certificate (watches, split shrinking), the base certificate log, the counts per
 //! triangle and bucket, stale marks and their lazy resolution.
 
-use super::*;
+use super::{KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, Op, State, Verdict, is_split};
+use crate::mesh::NONE;
 
 impl State<'_> {
     /// Recomputes the verdict of live candidate `c` and records its certificate.
