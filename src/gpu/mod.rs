@@ -17,10 +17,11 @@ mod device;
 pub mod layout;
 pub mod shader;
 pub mod synthetic;
+pub mod timing;
 
 pub use device::{
-    Kernel, KernelOptions, Layout, Timings, adapter_name, adapters, copy_bandwidth, evaluate,
-    is_software, open_device, stream_bandwidth,
+    Kernel, KernelOptions, Layout, Timings, adapter_name, adapters, evaluate, is_software,
+    open_device,
 };
 pub use layout::Batch;
 

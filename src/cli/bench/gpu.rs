@@ -2,6 +2,8 @@
 //! reference, the CPU twin (1 thread, all threads) and every Vulkan adapter (lavapipe, a real
 //! GPU), split into upload, kernel and readback, against the device's memory-bandwidth bound.
 
+mod bandwidth;
+
 use anyhow::Context;
 use quadrecomb::gpu::layout::LOCAL_QUAD_BYTES;
 use quadrecomb::gpu::{self, Batch, Kernel, KernelOptions, Layout, Timings, synthetic};
@@ -126,9 +128,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             } else {
                 1 << 30
             };
-            let copy = gpu::copy_bandwidth(&device, &queue, probe)
+            let copy = bandwidth::copy_bandwidth(&device, &queue, probe)
                 .with_context(|| format!("measuring the copy bandwidth of {name}"))?;
-            let stream = gpu::stream_bandwidth(&device, &queue, probe)
+            let stream = bandwidth::stream_bandwidth(&device, &queue, probe)
                 .with_context(|| format!("measuring the stream bandwidth of {name}"))?;
             let bw = copy.max(stream);
             println!(

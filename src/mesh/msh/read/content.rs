@@ -1,0 +1,324 @@
+//! What a reader collects: the node tag map, the mesh content (nodes, triangles, quads,
+//! skipped elements, partitions) and the parts of the file's model, with the functions
+//! that add an element to them.
+
+use super::parser::{Parser, Res};
+use crate::mesh::MeshData;
+use crate::mesh::msh::model::{Element, Entity, Model, PhysicalName};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
+
+/// Node tag -> dense vertex index.
+pub(super) enum NodeMap {
+    Dense(Vec<u32>),
+    Sparse(HashMap<u64, u32>),
+}
+
+impl NodeMap {
+    /// The map for `tags` (in vertex order), or the first tag that appears twice.
+    pub(super) fn new(tags: &[u64]) -> Result<NodeMap, u64> {
+        let max = tags.iter().copied().max().unwrap_or(0);
+        if max <= 4 * tags.len() as u64 + 1024 {
+            let mut dense = vec![u32::MAX; max as usize + 1];
+            for (i, &t) in tags.iter().enumerate() {
+                let slot = &mut dense[t as usize];
+                if *slot != u32::MAX {
+                    return Err(t);
+                }
+                *slot = i as u32;
+            }
+            Ok(NodeMap::Dense(dense))
+        } else {
+            let mut map = HashMap::with_capacity(tags.len());
+            for (i, &t) in tags.iter().enumerate() {
+                if map.insert(t, i as u32).is_some() {
+                    return Err(t);
+                }
+            }
+            Ok(NodeMap::Sparse(map))
+        }
+    }
+
+    #[inline]
+    pub(super) fn get(&self, tag: u64) -> Option<u32> {
+        match self {
+            NodeMap::Dense(v) => v.get(tag as usize).copied().filter(|&i| i != u32::MAX),
+            NodeMap::Sparse(m) => m.get(&tag).copied(),
+        }
+    }
+}
+
+/// The content of a MSH file, before validation.
+pub(super) struct Content {
+    pub(super) data: MeshData,
+    pub(super) node_tags: Vec<u64>,
+    /// Where each node tag is (offsets), noted only when a duplicate tag is looked for.
+    pub(super) tag_pos: Option<Vec<usize>>,
+    pub(super) map: Option<NodeMap>,
+    /// Skipped elements: count per Gmsh type and whether they were on a partition
+    /// interface (a surface inside a volume; see `interfaces`).
+    pub(super) skipped: BTreeMap<(i64, bool), usize>,
+    /// Partitioned files (4.1): the parent surface of each partition's surface entity.
+    pub(super) parents: HashMap<i64, i32>,
+    /// Partitioned 3D meshes (4.1): partition surfaces whose parent is a volume, the
+    /// interfaces between volume partitions. Their triangles lie inside the volume, not on
+    /// a model surface, and are skipped.
+    pub(super) interfaces: HashSet<i64>,
+    /// The model, as the file gives it (see [`ModelParts::finish`]).
+    pub(super) model: ModelParts,
+}
+
+/// The parts of the file's model, collected while reading.
+#[derive(Default)]
+pub(super) struct ModelParts {
+    pub(super) physical_names: Vec<PhysicalName>,
+    /// `$Entities` (4.1), if the file has it.
+    pub(super) entities: Option<Vec<Entity>>,
+    /// The entity of each node as the file gives it, aligned with `Content::node_tags`
+    /// (`None`: not given, MSH 2.2 `$Nodes`).
+    pub(super) node_entity: Vec<Option<(u8, i32)>>,
+    /// The parametric coordinates of each node, up to the last that has some (empty when
+    /// none has: most files).
+    pub(super) node_param: Vec<Option<[f64; 3]>>,
+    /// Point and line elements (on the file's entities).
+    pub(super) elements: Vec<Element>,
+    /// Every entity an element is on, with the physical tags the elements give it (MSH
+    /// 2.2; none in 4.1, where `$Entities` holds them).
+    pub(super) element_entities: BTreeMap<(u8, i32), BTreeSet<i32>>,
+    /// The last key added to `element_entities` (elements come in runs on one entity).
+    pub(super) last_entity: Option<(u8, i32, i32)>,
+    /// Partitioned files (4.1): the parent (dimension, tag) of each partition entity.
+    pub(super) parents: HashMap<(u8, i32), (u8, i32)>,
+}
+
+impl ModelParts {
+    /// Records the parametric coordinates of the node just added to `node_entity`.
+    #[inline]
+    pub(super) fn push_param(&mut self, u: Option<[f64; 3]>) {
+        if u.is_some() || !self.node_param.is_empty() {
+            self.node_param.resize(self.node_entity.len() - 1, None);
+            self.node_param.push(u);
+        }
+    }
+
+    /// Notes an element of dimension `dim` on entity `tag` in physical group `physical`
+    /// (0: none).
+    #[inline]
+    pub(super) fn on_entity(&mut self, dim: u8, tag: i32, physical: i32) {
+        if self.last_entity == Some((dim, tag, physical)) {
+            return;
+        }
+        self.last_entity = Some((dim, tag, physical));
+        let set = self.element_entities.entry((dim, tag)).or_default();
+        if physical != 0 {
+            set.insert(physical);
+        }
+    }
+
+    /// The model: partition entities replaced by their parents (elements and node
+    /// classifications on partition interfaces dropped, the parametric coordinates of a
+    /// node moved to a parent of another dimension dropped), nodes the file does not
+    /// classify put on the entity of the lowest-dimension element that holds them (as Gmsh
+    /// reads MSH 2.2), and entities that `$Entities` lacks derived from the elements.
+    pub(super) fn finish(mut self, data: &MeshData) -> Model {
+        if !self.parents.is_empty() {
+            let parents = &self.parents;
+            for (v, on) in self.node_entity.iter_mut().enumerate() {
+                if let Some((dim, tag)) = *on {
+                    if let Some(&(pd, pt)) = parents.get(&(dim, tag)) {
+                        *on = Some((pd, pt));
+                        if let (true, Some(param)) = (pd != dim, self.node_param.get_mut(v)) {
+                            *param = None;
+                        }
+                    }
+                }
+            }
+            self.elements
+                .retain_mut(|e| match parents.get(&(e.dim, e.entity)) {
+                    Some(&(pd, pt)) if pd == e.dim => {
+                        e.entity = pt;
+                        true
+                    }
+                    Some(_) => false,
+                    None => true,
+                });
+            let mut entities = BTreeMap::new();
+            for (&(dim, tag), physicals) in &self.element_entities {
+                let key = match parents.get(&(dim, tag)) {
+                    Some(&(pd, pt)) if pd == dim => (dim, pt),
+                    Some(_) => continue,
+                    None => (dim, tag),
+                };
+                entities
+                    .entry(key)
+                    .or_insert_with(BTreeSet::new)
+                    .extend(physicals);
+            }
+            self.element_entities = entities;
+        }
+        let nv = data.vertices.len();
+        self.node_entity.resize(nv, None);
+        if !self.node_param.is_empty() {
+            self.node_param.resize(nv, None);
+        }
+        if self.node_entity.iter().any(Option::is_none) {
+            let on = &mut self.node_entity;
+            let mut classify = |nodes: &[u32], dim: u8, tag: i32| {
+                for &v in nodes {
+                    if let Some(slot @ None) = on.get_mut(v as usize) {
+                        *slot = Some((dim, tag));
+                    }
+                }
+            };
+            for dim in [0, 1] {
+                for e in self.elements.iter().filter(|e| e.dim == dim) {
+                    classify(&e.nodes, dim, e.entity);
+                }
+            }
+            for (t, &s) in data.triangles.iter().zip(&data.triangle_surface) {
+                classify(t, 2, s);
+            }
+            for (q, &s) in data.quads.iter().zip(&data.quad_surface) {
+                classify(q, 2, s);
+            }
+        }
+        let mut entities = self.entities.unwrap_or_default();
+        let known: HashSet<(u8, i32)> = entities.iter().map(|e| (e.dim, e.tag)).collect();
+        for ((dim, tag), physicals) in self.element_entities {
+            if !known.contains(&(dim, tag)) {
+                entities.push(Entity {
+                    dim,
+                    tag,
+                    bbox: None,
+                    physicals: physicals.into_iter().collect(),
+                    bounding: Vec::new(),
+                });
+            }
+        }
+        Model {
+            physical_names: self.physical_names,
+            entities,
+            node_entity: self.node_entity,
+            node_param: self.node_param,
+            elements: self.elements,
+        }
+    }
+}
+
+impl Content {
+    pub(super) fn new() -> Content {
+        Content {
+            data: MeshData::default(),
+            node_tags: Vec::new(),
+            tag_pos: None,
+            map: None,
+            skipped: BTreeMap::new(),
+            parents: HashMap::new(),
+            interfaces: HashSet::new(),
+            model: ModelParts::default(),
+        }
+    }
+
+    /// Notes where the node tag just pushed is, when asked to (see [`duplicate_node`](super::duplicate_node)).
+    #[inline]
+    pub(super) fn note_tag(&mut self, pos: usize) {
+        if let Some(v) = &mut self.tag_pos {
+            v.push(pos);
+        }
+    }
+
+    /// Counts `n` skipped elements of type `etype` (on a partition interface or not).
+    pub(super) fn skip(&mut self, etype: i64, n: u64, on_interface: bool) {
+        *self.skipped.entry((etype, on_interface)).or_default() += n as usize;
+    }
+}
+
+/// Adds a triangle or quad (`nodes` are its 3 or 4 node tags) of element `tag` on `surface`, or counts an
+/// ignored element. `at` is where the element starts (for messages).
+#[inline]
+pub(super) fn push_element(
+    p: &Parser<'_>,
+    c: &mut Content,
+    map: &NodeMap,
+    at: usize,
+    tag: u64,
+    surface: i32,
+    nodes: &[u64],
+) -> Res<()> {
+    let mut idx = [0u32; 4];
+    for (k, &n) in nodes.iter().enumerate() {
+        idx[k] = map.get(n).ok_or_else(|| {
+            let msg = format!("element {tag} refers to node {n}, which does not exist");
+            p.err(at, msg)
+        })?;
+    }
+    if nodes.len() == 3 {
+        c.data.triangles.push([idx[0], idx[1], idx[2]]);
+        c.data.triangle_ids.push(tag);
+        c.data.triangle_surface.push(surface);
+    } else {
+        c.data.quads.push(idx);
+        c.data.quad_ids.push(tag);
+        c.data.quad_surface.push(surface);
+    }
+    Ok(())
+}
+
+/// Adds a point or line element (`nodes`: its node tags) of element `tag`, type `etype`
+/// and dimension `dim`, on entity `entity`, to the model.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn push_lower(
+    p: &Parser<'_>,
+    c: &mut Content,
+    map: &NodeMap,
+    at: usize,
+    tag: u64,
+    (etype, dim): (i64, u8),
+    entity: i32,
+    nodes: &[u64],
+) -> Res<()> {
+    let nodes = nodes
+        .iter()
+        .map(|&n| {
+            map.get(n).ok_or_else(|| {
+                let msg = format!("element {tag} refers to node {n}, which does not exist");
+                p.err(at, msg)
+            })
+        })
+        .collect::<Res<Vec<u32>>>()?;
+    c.model.elements.push(Element {
+        gmsh_type: etype,
+        dim,
+        entity,
+        nodes,
+    });
+    Ok(())
+}
+
+/// The first `n` of `u` as a node's parametric coordinates: none if `n` is 0 or one is not
+/// finite (then they are not written back).
+pub(super) fn parametric(n: usize, u: [f64; 3]) -> Option<[f64; 3]> {
+    (n > 0 && u.iter().all(|x| x.is_finite())).then_some(u)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn node_map_is_dense_for_compact_tags_and_sparse_otherwise() {
+        let dense = NodeMap::new(&[3, 1, 2]).unwrap();
+        assert!(matches!(dense, NodeMap::Dense(_)));
+        assert_eq!(
+            (dense.get(1), dense.get(3), dense.get(0), dense.get(99)),
+            (Some(1), Some(0), None, None)
+        );
+        let sparse = NodeMap::new(&[u64::MAX, 5]).unwrap();
+        assert!(matches!(sparse, NodeMap::Sparse(_)));
+        assert_eq!(
+            (sparse.get(u64::MAX), sparse.get(5), sparse.get(6)),
+            (Some(0), Some(1), None)
+        );
+        assert_eq!(NodeMap::new(&[4, 7, 4]).err(), Some(4));
+        assert_eq!(NodeMap::new(&[u64::MAX, 9, u64::MAX]).err(), Some(u64::MAX));
+    }
+}

@@ -1,0 +1,232 @@
+//! Building the state: the per-candidate and per-triangle records laid out for the
+//! criterion, the buckets, polders and `P_k` sets, and every initial verdict with its
+//! certificate ([`State::new`]).
+
+use super::pk::OrderedSets;
+use super::tree::Overlay;
+use super::{CandRecord, State, TriRecord, Verdict};
+use crate::mesh::{Mesh, NONE};
+use crate::quality::CandidateTable;
+
+impl<'a> State<'a> {
+    /// The initial state of `mesh` (every triangle remaining) with every verdict computed.
+    pub fn new(mesh: &'a Mesh, table: &'a CandidateTable) -> State<'a> {
+        let nt = mesh.num_triangles();
+        let nv = mesh.vertices.len();
+        let m = table.len();
+        // The dual graph of the candidates: the mesh's, less the pairs the rule dropped
+        // (those sides are boundaries for the criterion, like a surface's).
+        let dual = table.dual_graph();
+        let (polder, polder_size) = CandidateTable::components(&dual);
+        let nb = &dual;
+        let cand_nb: Vec<[u32; 4]> = (0..m)
+            .map(|c| {
+                let [t0, t1] = table.pairs[c];
+                let [s0, o1, s1, o0] = table.quads[c];
+                let across = |t: u32, a: u32, b: u32| {
+                    let tri = mesh.triangles[t as usize];
+                    (0..3)
+                        .find(|&i| {
+                            let (x, y) = (tri[i], tri[(i + 1) % 3]);
+                            (x == a && y == b) || (x == b && y == a)
+                        })
+                        .map_or(NONE, |i| nb[t as usize][i])
+                };
+                [
+                    across(t1, s0, o1),
+                    across(t1, o1, s1),
+                    across(t0, s1, o0),
+                    across(t0, o0, s0),
+                ]
+            })
+            .collect();
+        // Vertex fans: closed iff walking around v through the dual graph visits every
+        // incident triangle and comes back.
+        let mut vt_count = vec![0u32; nv];
+        let mut vt_first = vec![NONE; nv];
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for &v in tri {
+                vt_count[v as usize] += 1;
+                vt_first[v as usize] = t as u32;
+            }
+        }
+        let has_quad: Vec<bool> = {
+            let mut h = vec![false; nv];
+            for q in &mesh.quads {
+                for &v in q {
+                    h[v as usize] = true;
+                }
+            }
+            h
+        };
+        let closed: Vec<bool> = (0..nv)
+            .map(|v| {
+                let n = vt_count[v];
+                if n < 3 || has_quad[v] {
+                    return false;
+                }
+                let start = vt_first[v];
+                let (mut prev, mut cur) = (NONE, start);
+                for step in 0..n {
+                    let tri = mesh.triangles[cur as usize];
+                    let j = tri.iter().position(|&x| x == v as u32).expect("incident");
+                    let (a, b) = (nb[cur as usize][j], nb[cur as usize][(j + 2) % 3]);
+                    let next = if a != prev { a } else { b };
+                    if next == NONE || (step == 0 && a == NONE) {
+                        return false;
+                    }
+                    prev = cur;
+                    cur = next;
+                    if cur == start {
+                        return step + 1 == n;
+                    }
+                }
+                false
+            })
+            .collect();
+        let mut vc_start = vec![0u32; nv + 1];
+        for q in &table.quads {
+            for &v in q {
+                vc_start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..nv {
+            vc_start[v + 1] += vc_start[v];
+        }
+        let mut fill = vc_start.clone();
+        let mut vc_list = vec![0u32; vc_start[nv] as usize];
+        for (c, q) in table.quads.iter().enumerate() {
+            for &v in q {
+                vc_list[fill[v as usize] as usize] = c as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        let cand: Vec<CandRecord> = (0..m)
+            .map(|c| {
+                let (quad, nb) = (table.quads[c], cand_nb[c]);
+                let mut l = CandRecord {
+                    quad,
+                    nb,
+                    pair: table.pairs[c],
+                    verdict: Verdict::default(),
+                    cert_ver: 0,
+                    flags: 0,
+                    shared: false,
+                    dirty: false,
+                };
+                for i in 0..4 {
+                    if closed[quad[i] as usize] {
+                        l.flags |= 1 << i;
+                    }
+                    l.shared |= nb[i] != NONE && (0..i).any(|j| nb[j] == nb[i]);
+                }
+                l
+            })
+            .collect();
+        let tri: Vec<TriRecord> = (0..nt)
+            .map(|t| {
+                let tri = mesh.triangles[t];
+                let mut r = [tri[0], tri[1], tri[2], NONE, NONE, NONE];
+                for i in 0..3 {
+                    let u = nb[t][i];
+                    if u != NONE {
+                        let (a, b) = (tri[i], tri[(i + 1) % 3]);
+                        r[3 + i] = mesh.triangles[u as usize]
+                            .into_iter()
+                            .find(|&x| x != a && x != b)
+                            .unwrap_or(NONE);
+                    }
+                }
+                TriRecord {
+                    ring: r,
+                    nb: nb[t],
+                    cands: table.by_triangle[t],
+                }
+            })
+            .collect();
+        let mut st = State {
+            mesh,
+            table,
+            closed,
+            cand,
+            tri,
+            dual,
+            vc_start,
+            vc_list,
+            alive: vec![true; nt],
+            remaining: nt as u32,
+            count: vec![0; nt],
+            sets: OrderedSets::new(nt),
+            base_cert: Vec::new(),
+            base_cert_init: 0,
+            base_cert_compact_at: 0,
+            ver: 0,
+            dead_count: vec![0; nv],
+            polder,
+            polder_size,
+            watch: vec![Vec::new(); nt],
+            dsu_parent: (0..nv as u32).collect(),
+            dsu_size: vec![1; nv],
+            root_watch: vec![Vec::new(); nv],
+            arc_roots: [NONE; 4],
+            narcs: 0,
+            split: Vec::new(),
+            split_pos: vec![NONE; m],
+            dirty_list: Vec::new(),
+            chosen: Vec::new(),
+            quality: vec![0.0],
+            log: Vec::new(),
+            tree: Overlay::new(m, nv, nt),
+            forward: false,
+            initial: None,
+            last_local: NONE,
+            last_local_mask: 0,
+            stamp: vec![0; nt],
+            epoch: 0,
+            queue: Default::default(),
+            head: [0; 4],
+            nseed: [0; 4],
+            cert_len: [0; 4],
+            finished: [false; 4],
+            group: [0; 4],
+            nsearch: 0,
+            changed: Vec::new(),
+            moved: Vec::new(),
+            fan: Vec::new(),
+            searches: 0,
+            searched: 0,
+            split_shrinks: 0,
+        };
+        // The removed region at the start: boundary edges (mesh, surface and quad
+        // boundaries: dual sides without a neighbour) and input quads.
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for i in 0..3 {
+                if st.dual[t][i] == NONE {
+                    st.union(tri[i], tri[(i + 1) % 3]);
+                }
+            }
+        }
+        for q in &mesh.quads {
+            for i in 1..4 {
+                st.union(q[0], q[i]);
+            }
+        }
+        // Components without a cycle (corridors) all at once; a search per candidate
+        // elsewhere.
+        let acyclic = st.acyclic_parts();
+        for c in 0..m as u32 {
+            match acyclic.as_ref().and_then(|a| st.acyclic_verdict(a, c)) {
+                Some(r) => st.install_verdict(c, r),
+                None => st.recheck_one(c),
+            }
+        }
+        drop(acyclic);
+        // The initial verdicts are the base state: nothing to undo before it (and the log's
+        // memory, as large as every initial change, is given back).
+        st.log = Vec::new();
+        st.base_cert_init = st.base_cert.len();
+        st.base_cert.shrink_to_fit();
+        st.base_cert_compact_at = st.base_cert_init + m.max(1024);
+        st
+    }
+}

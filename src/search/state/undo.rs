@@ -1,0 +1,299 @@
+//! Applying and undoing actions through the change log: `apply` / `apply_lazy` record
+//! every change as an [`Op`], `undo` reverts the last action in O(1) per change, `reset`
+//! returns to the initial state.
+
+use super::{DEAD, Initial, KIND_LOCAL, Op, State, is_split};
+use crate::mesh::NONE;
+
+impl State<'_> {
+    /// Recombines the two triangles of candidate `c` (both must remain; the criterion is
+    /// not required, and stays exact after a forbidden action too).
+    pub fn apply(&mut self, c: u32) {
+        self.apply_lazy(c);
+        self.resolve_all();
+    }
+
+    /// Like [`State::apply`], but the verdicts the action may have changed are only marked;
+    /// the lazy queries (and `resolve_all`) recheck them when asked. For the trees.
+    pub fn apply_lazy(&mut self, c: u32) {
+        let ci = c as usize;
+        let [t0, t1] = self.cand[ci].pair;
+        assert!(
+            self.is_live(c),
+            "apply({c}): a triangle of the pair is already used"
+        );
+        // An exact verdict that found one part needs no new search; a split does (its
+        // parts are relabelled).
+        let v = self.cand[ci].verdict;
+        let exact_before = self.dirty_list.is_empty();
+        let r = if !self.cand[ci].dirty && v.allowed && !is_split(v.kind) {
+            v
+        } else {
+            self.check(c)
+        };
+        let split = is_split(r.kind);
+        self.last_local = if exact_before && r.kind == KIND_LOCAL {
+            c
+        } else {
+            NONE
+        };
+        self.last_local_mask = r.mask;
+        if self.forward {
+            // Nothing will be undone: the log only serves the trees.
+            self.log.clear();
+        } else {
+            self.log.push(Op::Apply(c));
+        }
+        self.changed.clear();
+        if split {
+            self.relabel_split(t0);
+        } else {
+            let p = self.polder[t0 as usize];
+            let psize = self.polder_size[p as usize];
+            self.base_log(Op::PolderSize { p, old: psize });
+            self.polder_size[p as usize] = psize - 2;
+        }
+        // Remove the pair.
+        self.alive[t0 as usize] = false;
+        self.alive[t1 as usize] = false;
+        self.stamp[t0 as usize] = DEAD;
+        self.stamp[t1 as usize] = DEAD;
+        self.remaining -= 2;
+        self.chosen.push(c);
+        let total = self.quality() + self.table.eta[ci];
+        self.quality.push(total);
+        for x in [t0, t1] {
+            self.set_count(x, 0);
+            for c2 in self.tri[x as usize].cands {
+                if c2 != NONE && self.cand[c2 as usize].verdict.allowed {
+                    self.set_verdict_dead(c2);
+                    let u = self.other(c2, x);
+                    if self.alive[u as usize] {
+                        let k = self.count[u as usize];
+                        self.set_count(u, k - 1);
+                    }
+                }
+            }
+        }
+        // Vertices whose fan lost its first triangle: their links are gone.
+        self.moved.clear();
+        for x in [t0, t1] {
+            for v in self.verts(x) {
+                let vi = v as usize;
+                if self.dead_count[vi] == 0 && self.closed[vi] {
+                    self.moved.push(v);
+                }
+                self.dead_count[vi] += 1;
+            }
+        }
+        // The quad joins the dead components at its four vertices.
+        let qv = self.cand[ci].quad;
+        for i in 1..4 {
+            if let Some(child) = self.union(qv[0], qv[i]) {
+                for j in 0..self.root_watch[child as usize].len() {
+                    let (c2, ver) = self.root_watch[child as usize][j];
+                    if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
+                        self.mark(c2);
+                    }
+                }
+            }
+        }
+        for i in 0..self.moved.len() {
+            let v = self.moved[i] as usize;
+            for j in self.vc_start[v]..self.vc_start[v + 1] {
+                let c2 = self.vc_list[j as usize];
+                if self.is_live(c2) {
+                    self.mark(c2);
+                }
+            }
+        }
+        for x in [t0, t1] {
+            // Marking touches no watch list: iterate the list taken out, then put it back.
+            let list = std::mem::take(&mut self.watch[x as usize]);
+            for &(c2, ver) in &list {
+                if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
+                    self.mark(c2);
+                }
+            }
+            self.watch[x as usize] = list;
+        }
+        if !self.changed.is_empty() {
+            for i in 0..self.split.len() {
+                let c2 = self.split[i];
+                if self.is_live(c2) {
+                    let pc = self.polder[self.cand[c2 as usize].pair[0] as usize];
+                    if self.changed.contains(&pc) {
+                        self.mark(c2);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Reverts the last `apply`. Panics when nothing was applied.
+    pub fn undo(&mut self) {
+        assert!(!self.chosen.is_empty(), "undo with nothing applied");
+        assert!(!self.forward, "undo in forward mode");
+        assert!(self.tree.is_empty(), "undo inside a look-ahead tree");
+        while let Some(op) = self.log.pop() {
+            if self.undo_shared(op) {
+                continue;
+            }
+            match op {
+                Op::Apply(c) => {
+                    let [t0, t1] = self.cand[c as usize].pair;
+                    for x in [t0, t1] {
+                        self.alive[x as usize] = true;
+                        self.stamp[x as usize] = 0;
+                        for v in self.verts(x) {
+                            self.dead_count[v as usize] -= 1;
+                        }
+                    }
+                    self.remaining += 2;
+                    self.chosen.pop();
+                    self.quality.pop();
+                    return;
+                }
+                Op::Verdict { c, old, ver } => {
+                    self.cand[c as usize].verdict = old;
+                    self.cand[c as usize].cert_ver = ver;
+                }
+                Op::Count { t, old } => {
+                    let cur = self.count[t as usize];
+                    self.move_count(t, cur, old);
+                }
+                Op::TreeApply(_)
+                | Op::Polder { .. }
+                | Op::PolderNew
+                | Op::PolderSize { .. }
+                | Op::Union { .. } => unreachable!("handled by undo_shared"),
+                Op::Watch(t) => {
+                    self.watch[t as usize].pop();
+                }
+                Op::SplitIns => {
+                    let c = self.split.pop().expect("split entry");
+                    self.split_pos[c as usize] = NONE;
+                }
+                Op::RootWatch(v) => {
+                    self.root_watch[v as usize].pop();
+                }
+                Op::Dirty => {
+                    let c = self.dirty_list.pop().expect("dirty entry");
+                    self.cand[c as usize].dirty = false;
+                }
+                Op::Clean(c) => self.cand[c as usize].dirty = true,
+                Op::DirtyPop(c) => self.dirty_list.push(c),
+                Op::SplitRem { c, pos } => {
+                    let p = pos as usize;
+                    if p == self.split.len() {
+                        self.split.push(c);
+                    } else {
+                        let y = self.split[p];
+                        self.split.push(y);
+                        self.split_pos[y as usize] = (self.split.len() - 1) as u32;
+                        self.split[p] = c;
+                    }
+                    self.split_pos[c as usize] = pos;
+                }
+            }
+        }
+        unreachable!("undo log without an Apply marker");
+    }
+
+    /// Reverts every action applied.
+    pub fn reset(&mut self) {
+        assert!(self.tree.is_empty(), "reset inside a look-ahead tree");
+        if self.forward {
+            self.restore_initial();
+        } else {
+            while !self.chosen.is_empty() {
+                self.undo();
+            }
+        }
+        self.base_cert.truncate(self.base_cert_init);
+    }
+
+    /// Forward mode (for runs, which never undo an applied action): `apply` keeps no undo
+    /// log (look-ahead trees still undo their pushes) and [`State::reset`] restores a copy
+    /// of the initial state instead of undoing every action. `undo` panics in this mode.
+    /// Only at the initial state.
+    pub fn set_forward(&mut self, on: bool) {
+        assert!(self.chosen.is_empty(), "set_forward with actions applied");
+        if on && self.initial.is_none() {
+            self.initial = Some(Box::new(Initial {
+                verdict: self.cand.iter().map(|l| l.verdict).collect(),
+                cert_ver: self.cand.iter().map(|l| l.cert_ver).collect(),
+                count: self.count.clone(),
+                sets: self.sets.clone(),
+                polder: self.polder.clone(),
+                polder_size: self.polder_size.clone(),
+                dsu_parent: self.dsu_parent.clone(),
+                dsu_size: self.dsu_size.clone(),
+                split: self.split.clone(),
+                split_pos: self.split_pos.clone(),
+                watch_len: self.watch.iter().map(|w| w.len() as u32).collect(),
+                root_watch_len: self.root_watch.iter().map(|w| w.len() as u32).collect(),
+                ver: self.ver,
+            }));
+        }
+        self.forward = on;
+        self.log.clear();
+    }
+
+    /// Forward mode's reset: copies the initial state back.
+    fn restore_initial(&mut self) {
+        let init = self
+            .initial
+            .as_ref()
+            .expect("forward mode keeps the initial state");
+        for (c, (v, &ver)) in init.verdict.iter().zip(&init.cert_ver).enumerate() {
+            self.cand[c].verdict = *v;
+            self.cand[c].cert_ver = ver;
+        }
+        self.count.copy_from_slice(&init.count);
+        self.sets.clone_from(&init.sets);
+        self.polder.copy_from_slice(&init.polder);
+        self.polder_size.clone_from(&init.polder_size);
+        self.dsu_parent.copy_from_slice(&init.dsu_parent);
+        self.dsu_size.copy_from_slice(&init.dsu_size);
+        self.split.clone_from(&init.split);
+        self.split_pos.copy_from_slice(&init.split_pos);
+        for (w, &n) in self.watch.iter_mut().zip(&init.watch_len) {
+            w.truncate(n as usize);
+        }
+        for (w, &n) in self.root_watch.iter_mut().zip(&init.root_watch_len) {
+            w.truncate(n as usize);
+        }
+        self.ver = init.ver;
+        for &c in &self.dirty_list {
+            self.cand[c as usize].dirty = false;
+        }
+        self.dirty_list.clear();
+        self.alive.iter_mut().for_each(|a| *a = true);
+        self.dead_count.iter_mut().for_each(|d| *d = 0);
+        self.stamp.iter_mut().for_each(|s| *s = 0);
+        self.remaining = self.alive.len() as u32;
+        self.chosen.clear();
+        self.quality.truncate(1);
+        self.log.clear();
+    }
+
+    /// Reverts the changes that base applies and tree pushes share (polders, dead
+    /// components); false for any other change.
+    #[inline]
+    pub(super) fn undo_shared(&mut self, op: Op) -> bool {
+        match op {
+            Op::Polder { t, old } => self.polder[t as usize] = old,
+            Op::PolderNew => {
+                self.polder_size.pop();
+            }
+            Op::PolderSize { p, old } => self.polder_size[p as usize] = old,
+            Op::Union { child, root } => {
+                self.dsu_parent[child as usize] = child;
+                self.dsu_size[root as usize] -= self.dsu_size[child as usize];
+            }
+            _ => return false,
+        }
+        true
+    }
+}

@@ -1,0 +1,356 @@
+//! Keeping verdicts current: rechecking a candidate and installing its verdict and
+//! certificate (watches, split shrinking), the base certificate log, the counts per
+//! triangle and bucket, stale marks and their lazy resolution.
+
+use super::{KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, Op, State, Verdict, is_split};
+use crate::mesh::NONE;
+
+impl State<'_> {
+    /// Recomputes the verdict of live candidate `c` and records its certificate.
+    pub(super) fn recheck_one(&mut self, c: u32) {
+        if self.forward && self.base_cert.len() >= self.base_cert_compact_at {
+            self.compact_base_cert();
+        }
+        if self.shrink_split(c) {
+            return;
+        }
+        let r = self.check(c);
+        self.install_verdict(c, r);
+    }
+
+    /// Makes `r` the verdict of `c`, its certificate the one the last check left in scratch
+    /// ([`State::append_cert`]), and updates the counts, watch lists and split list.
+    pub(super) fn install_verdict(&mut self, c: u32, mut r: Verdict) {
+        let ci = c as usize;
+        let old = self.cand[ci].verdict;
+        // A verdict of the local kind is never read back through its mask (the trees
+        // recompute the local proof first), so a new mask alone is not a change.
+        if r.kind == KIND_LOCAL && old.kind == KIND_LOCAL && r.allowed == old.allowed {
+            return;
+        }
+        self.base_log(Op::Verdict {
+            c,
+            old,
+            ver: self.cand[ci].cert_ver,
+        });
+        self.ver = self.ver.wrapping_add(1);
+        let ver = self.ver;
+        self.cand[ci].cert_ver = ver;
+        (r.cert, r.cert_len) = self.append_cert(r.kind, false);
+        self.cand[ci].verdict = r;
+        if r.allowed != old.allowed {
+            let [t0, t1] = self.cand[ci].pair;
+            for t in [t0, t1] {
+                let k = self.count[t as usize];
+                self.set_count(t, if r.allowed { k + 1 } else { k - 1 });
+            }
+        }
+        if r.kind == KIND_DISTINCT {
+            for i in 0..self.narcs {
+                let root = self.arc_roots[i];
+                self.root_watch[root as usize].push((c, ver));
+                self.base_log(Op::RootWatch(root));
+            }
+        } else if r.kind != KIND_LOCAL {
+            for s in 0..self.nsearch {
+                for i in 0..self.cert_len[s] {
+                    let t = self.queue[s][i];
+                    self.watch_push(t, c, ver);
+                }
+            }
+        }
+        let in_split = self.split_pos[ci] != NONE;
+        if is_split(r.kind) && !in_split {
+            self.split_pos[ci] = self.split.len() as u32;
+            self.split.push(c);
+            self.base_log(Op::SplitIns);
+        } else if !is_split(r.kind) && in_split {
+            let p = self.split_pos[ci];
+            self.split.swap_remove(p as usize);
+            if let Some(&y) = self.split.get(p as usize) {
+                self.split_pos[y as usize] = p;
+            }
+            self.split_pos[ci] = NONE;
+            self.base_log(Op::SplitRem { c, pos: p });
+        }
+    }
+
+    /// Keeps the split verdict of `c` without a new search when the only change since it
+    /// was exact is the last action `y`, applied with a local proof, sharing no vertex
+    /// with `c`, inside one of the parts `c` would leave. That part minus `y`'s pair is
+    /// still one part: `y`'s remaining neighbours stay joined through the fans of its clean
+    /// vertices, which hold no triangle of `c` (no shared vertex) and no used one. Its
+    /// parity is unchanged (two triangles fewer), and so is the verdict. The certificate
+    /// drops the pair: a finished part's list is the whole part again (rewritten in place
+    /// when it was written after the initial state, else copied); the running part's paths
+    /// along which its searches met gain those fans, through which they still meet
+    /// (copied). Forward mode only (nothing to undo). A split verdict's certificate lists
+    /// its finished parts first, `fin_known` triangles in all.
+    fn shrink_split(&mut self, c: u32) -> bool {
+        let y = self.last_local;
+        if y == NONE || !self.forward || self.chosen.last() != Some(&y) {
+            return false;
+        }
+        let ci = c as usize;
+        let v = self.cand[ci].verdict;
+        if v.kind != KIND_SPLIT {
+            return false;
+        }
+        let (qc, qy) = (self.cand[ci].quad, self.cand[y as usize].quad);
+        if qc.iter().any(|a| qy.contains(a)) {
+            return false;
+        }
+        let [a, b] = self.cand[y as usize].pair;
+        let (off, fin, len) = (v.cert as usize, v.fin_known as usize, v.cert_len as usize);
+        let cert = &self.base_cert[off..off + len];
+        let keep = |t: &u32| *t != a && *t != b;
+        let (off, len, fin_known) = if let Some(ia) = cert[..fin].iter().position(|&t| t == a) {
+            let ib = cert[..fin].iter().position(|&t| t == b);
+            let ib = ib.expect("both triangles of a pair are in the same part");
+            let (lo, hi) = (ia.min(ib), ia.max(ib));
+            if off >= self.base_cert_init {
+                // Swap the pair to the end of the finished parts, then close the gap.
+                let arena = &mut self.base_cert;
+                arena.swap(off + hi, off + fin - 1);
+                arena.swap(off + lo, off + fin - 2);
+                arena.copy_within(off + fin..off + len, off + fin - 2);
+                (off, len - 2, v.fin_known - 2)
+            } else {
+                let new = self.base_cert.len();
+                for i in off..off + len {
+                    let t = self.base_cert[i];
+                    if keep(&t) {
+                        self.base_cert.push(t);
+                    }
+                }
+                (new, len - 2, v.fin_known - 2)
+            }
+        } else {
+            if !cert[fin..].iter().any(|t| !keep(t)) || !self.fans(y, self.last_local_mask) {
+                return false;
+            }
+            let new = self.base_cert.len();
+            self.base_cert.extend_from_within(off..off + fin);
+            for i in off + fin..off + len {
+                let t = self.base_cert[i];
+                if keep(&t) {
+                    self.base_cert.push(t);
+                }
+            }
+            let ver = self.cand[ci].cert_ver;
+            for i in 0..self.fan.len() {
+                let t = self.fan[i];
+                self.base_cert.push(t);
+                self.watch_push(t, c, ver);
+            }
+            (new, self.base_cert.len() - new, v.fin_known)
+        };
+        let kept = Verdict {
+            cert: off as u32,
+            cert_len: len as u32,
+            fin_known,
+            ..v
+        };
+        self.cand[ci].verdict = kept;
+        self.split_shrinks += 1;
+        true
+    }
+
+    /// The triangles around the clean quad vertices `mask` of candidate `y` (both of its
+    /// triangles remaining), `y`'s own excepted, into `self.fan`; false when a fan does not
+    /// close within 64 steps.
+    fn fans(&mut self, y: u32, mask: u8) -> bool {
+        self.fan.clear();
+        let [a, b] = self.cand[y as usize].pair;
+        let q = self.cand[y as usize].quad;
+        for (i, &v) in q.iter().enumerate() {
+            if mask & (1 << i) == 0 {
+                continue;
+            }
+            let start = if self.verts(a).contains(&v) { a } else { b };
+            // Walk around v: leave each triangle across its other edge at v.
+            let (mut t, mut prev) = (start, NONE);
+            for _ in 0..64 {
+                let r = &self.tri[t as usize];
+                let k = r.ring[..3]
+                    .iter()
+                    .position(|&x| x == v)
+                    .expect("v is a corner");
+                // Edges at v: (tri[k], tri[k+1]) is side k, (tri[k-1], tri[k]) side k-1.
+                let (s1, s2) = (r.nb[k], r.nb[(k + 2) % 3]);
+                let next = if s1 != prev { s1 } else { s2 };
+                if next == NONE {
+                    return false;
+                }
+                prev = t;
+                t = next;
+                if t == start {
+                    break;
+                }
+                if t != a && t != b && !self.fan.contains(&t) {
+                    self.fan.push(t);
+                }
+            }
+            if t != start {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Forward mode: the certificate arena keeps only what the current verdicts of live
+    /// candidates refer to (past the initial verdicts', which a reset brings back). Runs
+    /// append a certificate per recomputed verdict; without this the arena grew with every
+    /// recheck of a run (1.6 GB for greedy on a 10^6-triangle grid). Called when the arena
+    /// has grown by the candidate count and twice what was kept, so the copying costs O(1)
+    /// per appended entry.
+    fn compact_base_cert(&mut self) {
+        debug_assert!(self.forward, "undo logs refer to arena offsets");
+        let init = self.base_cert_init;
+        let mut kept: Vec<u32> = Vec::new();
+        for c in 0..self.cand.len() {
+            let v = self.cand[c].verdict;
+            if (v.cert as usize) < init || v.cert_len == 0 {
+                continue;
+            }
+            let [a, b] = self.cand[c].pair;
+            let v = &mut self.cand[c].verdict;
+            if !self.alive[a as usize] || !self.alive[b as usize] {
+                // Never read again before a reset restores the initial verdicts.
+                (v.cert, v.cert_len) = (0, 0);
+                continue;
+            }
+            let (off, len) = (v.cert as usize, v.cert_len as usize);
+            v.cert = (init + kept.len()) as u32;
+            kept.extend_from_slice(&self.base_cert[off..off + len]);
+        }
+        self.base_cert.truncate(init);
+        self.base_cert.extend_from_slice(&kept);
+        self.base_cert_compact_at = init + (2 * kept.len()).max(self.cand.len()).max(1024);
+    }
+
+    /// Logs a change of the base state for `undo`; forward mode undoes nothing and keeps
+    /// no log.
+    #[inline]
+    pub(super) fn base_log(&mut self, op: Op) {
+        if !self.forward {
+            self.log.push(op);
+        }
+    }
+
+    /// Adds `(c, ver)` to the watch list of triangle `t` (logged). In forward mode, where
+    /// nothing is undone, a list that doubled is first cleared of the entries of verdicts
+    /// since recomputed (those past the initial state's, which a reset brings back).
+    fn watch_push(&mut self, t: u32, c: u32, ver: u32) {
+        let list = &mut self.watch[t as usize];
+        if self.forward && list.len() >= 16 && list.len().is_power_of_two() {
+            let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]) as usize;
+            let cand = &self.cand;
+            let mut w = keep;
+            for r in keep..list.len() {
+                let (c2, v2) = list[r];
+                if cand[c2 as usize].cert_ver == v2 {
+                    list[w] = (c2, v2);
+                    w += 1;
+                }
+            }
+            list.truncate(w);
+        }
+        list.push((c, ver));
+        self.base_log(Op::Watch(t));
+    }
+
+    /// Moves triangle `t` from `P_old` to `P_new` (logged).
+    pub(super) fn set_count(&mut self, t: u32, new: u8) {
+        let old = self.count[t as usize];
+        if old == new {
+            return;
+        }
+        self.move_count(t, old, new);
+        self.base_log(Op::Count { t, old });
+    }
+
+    /// Sets the count of `t` from `old` to `new` and moves it between the sets.
+    #[inline]
+    pub(super) fn move_count(&mut self, t: u32, old: u8, new: u8) {
+        if old > 0 {
+            self.sets.remove(old as usize, t);
+        }
+        if new > 0 {
+            self.sets.insert(new as usize, t);
+        }
+        self.count[t as usize] = new;
+    }
+
+    pub(super) fn set_verdict_dead(&mut self, c: u32) {
+        let ci = c as usize;
+        self.base_log(Op::Verdict {
+            c,
+            old: self.cand[ci].verdict,
+            ver: self.cand[ci].cert_ver,
+        });
+        self.cand[ci].verdict.allowed = false;
+    }
+
+    /// Marks the verdict of `c` as possibly stale (logged).
+    pub(super) fn mark(&mut self, c: u32) {
+        let ci = c as usize;
+        if !self.cand[ci].dirty {
+            self.cand[ci].dirty = true;
+            self.dirty_list.push(c);
+            self.base_log(Op::Dirty);
+        }
+    }
+
+    /// Makes the verdict of `c` exact (rechecks it if it was marked stale).
+    #[inline]
+    pub(crate) fn resolve(&mut self, c: u32) {
+        if self.cand[c as usize].dirty {
+            self.resolve_slow(c);
+        }
+    }
+
+    fn resolve_slow(&mut self, c: u32) {
+        if self.is_live(c) {
+            self.recheck_one(c);
+        }
+        self.cand[c as usize].dirty = false;
+        self.base_log(Op::Clean(c));
+    }
+
+    /// Makes every verdict exact.
+    pub fn resolve_all(&mut self) {
+        while let Some(c) = self.dirty_list.pop() {
+            self.base_log(Op::DirtyPop(c));
+            if self.cand[c as usize].dirty {
+                self.resolve_slow(c);
+            }
+        }
+    }
+
+    /// Candidates marked stale since the list was last emptied (from position `from`):
+    /// lets greedy revisit exactly the actions whose verdict may have changed.
+    pub(crate) fn dirty_since(&self, from: usize) -> &[u32] {
+        &self.dirty_list[from.min(self.dirty_list.len())..]
+    }
+
+    /// Exact allowed-ness inside a lazy tree (rechecks `c` first if needed).
+    #[inline]
+    pub fn is_allowed_lazy(&mut self, c: u32) -> bool {
+        self.resolve(c);
+        self.is_allowed(c)
+    }
+
+    /// Exact number of allowed actions of `t` inside a lazy tree.
+    #[inline]
+    pub fn allowed_count_lazy(&mut self, t: u32) -> u32 {
+        if self.alive[t as usize] {
+            for c in self.tri[t as usize].cands {
+                if c != NONE {
+                    self.resolve(c);
+                }
+            }
+        }
+        self.count[t as usize] as u32
+    }
+}
