@@ -36,6 +36,8 @@ echo "== cargo clippy"
 cargo clippy --all-targets -- -D warnings
 echo "== cargo test (release)"
 cargo test --release
+echo "== cargo bench (each benchmark once, as a test)"
+cargo bench --bench benches -- --test
 echo "== cargo doc"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 echo "== all checks passed"

@@ -3,8 +3,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use quadrecomb::mesh::{Recombined, msh};
-use quadrecomb::quality::CandidateTable;
+use quadrecomb::internals::mesh::{Recombined, msh};
+use quadrecomb::internals::quality::CandidateTable;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(m) = msh::read_bytes("fuzz.msh", data) {

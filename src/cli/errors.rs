@@ -13,9 +13,9 @@
 
 use std::error::Error;
 
-use quadrecomb::experiment::ExperimentError;
-use quadrecomb::gpu::GpuError;
-use quadrecomb::report::ReportError;
+use quadrecomb::internals::experiment::ExperimentError;
+use quadrecomb::internals::gpu::GpuError;
+use quadrecomb::internals::report::ReportError;
 
 use super::BadInput;
 
@@ -46,7 +46,9 @@ fn code(e: &(dyn Error + 'static)) -> Option<u8> {
     if e.is::<super::InputError>() {
         return Some(EXIT_BAD_INPUT);
     }
-    if e.is::<quadrecomb::mesh::ReadError>() || e.is::<quadrecomb::mesh::MeshError>() {
+    if e.is::<quadrecomb::internals::mesh::ReadError>()
+        || e.is::<quadrecomb::internals::mesh::MeshError>()
+    {
         return Some(EXIT_BAD_INPUT);
     }
     if let Some(e) = e.downcast_ref::<ExperimentError>() {

@@ -2,8 +2,8 @@
 //! one-cell-wide strip, spiral and maze), written as MSH 4.1 ASCII.
 
 use super::BadInput;
-use quadrecomb::mesh::Recombined;
-use quadrecomb::mesh::generate::{self, Corridor, GridSpec, MAX_SUBDIVISIONS};
+use quadrecomb::internals::mesh::Recombined;
+use quadrecomb::internals::mesh::generate::{self, Corridor, GridSpec, MAX_SUBDIVISIONS};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -182,7 +182,7 @@ fn check_memory(triangles: usize) -> Result<(), BadInput> {
 fn corridor(
     shape: Corridor,
     a: CorridorArgs,
-) -> anyhow::Result<(quadrecomb::mesh::Mesh, String, PathBuf)> {
+) -> anyhow::Result<(quadrecomb::internals::mesh::Mesh, String, PathBuf)> {
     generate::validate_corridor(shape, a.triangles).map_err(|e| BadInput(e.to_string()))?;
     check_output(&a.output)?;
     let what = format!("{}, seed {}", shape.name(), a.seed);

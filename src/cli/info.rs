@@ -1,7 +1,7 @@
 //! `quadrecomb info`: a mesh's size, topology and candidate quad qualities, with parse time.
 
-use quadrecomb::mesh;
-use quadrecomb::quality::{self, CandidateTable, Rule};
+use quadrecomb::internals::mesh;
+use quadrecomb::internals::quality::{self, CandidateTable, Rule};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::io::Write as _;

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use quadrecomb::experiment::merge::merge;
+use quadrecomb::internals::experiment::merge::merge;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -29,8 +29,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     );
     if !args.no_report {
         let out = &args.out;
-        let paths = quadrecomb::report::write(out, &quadrecomb::report::ReportOptions::default())
-            .with_context(|| {
+        let paths = quadrecomb::internals::report::write(
+            out,
+            &quadrecomb::internals::report::ReportOptions::default(),
+        )
+        .with_context(|| {
             format!(
                 "the merged results are complete in {}, but writing their report failed \
                      (retry with `quadrecomb report {}`)",

@@ -84,8 +84,8 @@ pub struct RuleArgs {
 
 impl RuleArgs {
     /// The rule, or a usage error naming the flag.
-    pub fn rule(&self) -> Result<quadrecomb::quality::Rule, BadInput> {
-        quadrecomb::quality::Rule::new(self.min_eta, self.allow_invalid)
+    pub fn rule(&self) -> Result<quadrecomb::internals::quality::Rule, BadInput> {
+        quadrecomb::internals::quality::Rule::new(self.min_eta, self.allow_invalid)
             .map_err(|e| BadInput(format!("--min-eta: {e}")))
     }
 }
@@ -93,8 +93,8 @@ impl RuleArgs {
 /// Adds the element-quality fields and the rule to a `--json` object (the record's names).
 pub fn add_element_fields(
     v: &mut serde_json::Value,
-    e: &quadrecomb::quality::ElementQuality,
-    rule: quadrecomb::quality::Rule,
+    e: &quadrecomb::internals::quality::ElementQuality,
+    rule: quadrecomb::internals::quality::Rule,
 ) {
     v["worst_eta"] = serde_json::json!(e.worst);
     v["mean_eta"] = serde_json::json!(e.mean);
@@ -106,8 +106,8 @@ pub fn add_element_fields(
 
 /// The element-quality lines of the text output.
 pub fn print_element_lines(
-    e: &quadrecomb::quality::ElementQuality,
-    rule: quadrecomb::quality::Rule,
+    e: &quadrecomb::internals::quality::ElementQuality,
+    rule: quadrecomb::internals::quality::Rule,
 ) {
     if let (Some(worst), Some(mean)) = (e.worst, e.mean) {
         println!("quad eta        worst {worst:.4}, mean {mean:.4}");
@@ -205,20 +205,20 @@ fn output_kind(path: &std::path::Path) -> Option<bool> {
 /// never leaves a partial mesh behind.
 pub fn write_mesh_output(
     path: &std::path::Path,
-    mesh: &quadrecomb::mesh::Mesh,
-    rec: &quadrecomb::mesh::Recombined,
+    mesh: &quadrecomb::internals::mesh::Mesh,
+    rec: &quadrecomb::internals::mesh::Recombined,
 ) -> Result<(), BadInput> {
     let vtu = output_kind(path) == Some(true);
-    quadrecomb::output::write_atomic(path, |mut w| {
+    quadrecomb::internals::output::write_atomic(path, |mut w| {
         if vtu {
-            quadrecomb::mesh::vtu::write_to(
+            quadrecomb::internals::mesh::vtu::write_to(
                 &mut w,
                 mesh,
                 rec,
-                quadrecomb::mesh::vtu::Encoding::Binary,
+                quadrecomb::internals::mesh::vtu::Encoding::Binary,
             )
         } else {
-            quadrecomb::mesh::msh::write_to(&mut w, mesh, rec)
+            quadrecomb::internals::mesh::msh::write_to(&mut w, mesh, rec)
         }
     })
     .map_err(|e| {

@@ -1,7 +1,7 @@
 //! `quadrecomb optimum`: the exact optimum (maximum-weight matching of maximum cardinality).
 
-use quadrecomb::quality::{self, CandidateTable, ElementQuality};
-use quadrecomb::search::optimum;
+use quadrecomb::internals::quality::{self, CandidateTable, ElementQuality};
+use quadrecomb::internals::search::optimum;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -30,7 +30,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     super::check_mesh_output(args.output.as_deref())?;
     let rule = args.rule.rule()?;
     super::check_not_input(args.output.as_deref(), &args.mesh)?;
-    let mesh = quadrecomb::mesh::load(&args.mesh)?;
+    let mesh = quadrecomb::internals::mesh::load(&args.mesh)?;
     let table = CandidateTable::build(&mesh).restrict(&mesh, rule);
     let (opt, report) = optimum::solve_certified(&mesh, &table, args.check);
     let nt = mesh.num_triangles();

@@ -4,7 +4,7 @@
 //! ([`Searcher::set_progress`]) and prints nothing.
 
 use indicatif::{ProgressBar, ProgressStyle};
-use quadrecomb::search::{Progress, Searcher};
+use quadrecomb::internals::search::{Progress, Searcher};
 
 /// A run estimated to last longer than this gets a warning.
 const WARN_ABOVE_S: f64 = 60.0;

@@ -1,9 +1,9 @@
 //! `quadrecomb recombine`: one run of one policy on one mesh.
 
 use super::BadInput;
-use quadrecomb::experiment::replay::{self, EtaSource};
-use quadrecomb::quality::{self, CandidateTable, ElementQuality, Rule};
-use quadrecomb::search::{self, Algo, optimum};
+use quadrecomb::internals::experiment::replay::{self, EtaSource};
+use quadrecomb::internals::quality::{self, CandidateTable, ElementQuality, Rule};
+use quadrecomb::internals::search::{self, Algo, optimum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -67,7 +67,7 @@ pub struct Args {
 /// The candidate table of `mesh` with eta from `backend`, restricted to the pairs `rule`
 /// allows, and the evaluator's name.
 pub fn eta_table(
-    mesh: &quadrecomb::mesh::Mesh,
+    mesh: &quadrecomb::internals::mesh::Mesh,
     backend: EtaBackend,
     rule: Rule,
 ) -> anyhow::Result<(CandidateTable, String)> {
@@ -104,7 +104,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     super::check_not_input(args.output.as_deref(), &args.mesh)?;
     use super::oom::{self, Phase};
     oom::phase(Phase::Reading);
-    let mesh = quadrecomb::mesh::load(&args.mesh)?;
+    let mesh = quadrecomb::internals::mesh::load(&args.mesh)?;
     oom::mesh_size(mesh.num_triangles());
     oom::phase(Phase::Candidates);
     let (table, backend) = eta_table(&mesh, args.backend, rule)?;

@@ -1,10 +1,10 @@
 //! `quadrecomb replay DIR [RUN]`: one recorded run of a sweep re-run with the record's mesh,
-//! eta and rule (through [`quadrecomb::experiment::replay`], as the report's pictures), checked
+//! eta and rule (through [`quadrecomb::internals::experiment::replay`], as the report's pictures), checked
 //! against its record, and optionally written as `.msh` / `.vtu`.
 
 use super::BadInput;
-use quadrecomb::experiment::replay::{self, EtaCheck, Replayer};
-use quadrecomb::report::{Config, Results, Run};
+use quadrecomb::internals::experiment::replay::{self, EtaCheck, Replayer};
+use quadrecomb::internals::report::{Config, Results, Run};
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -1,7 +1,7 @@
 //! `quadrecomb report DIR [--compare DIR2] [--zoom x0,y0,x1,y1]`.
 
 use super::BadInput;
-use quadrecomb::report::{self, ReportOptions};
+use quadrecomb::internals::report::{self, ReportOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -5,13 +5,13 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context;
-use quadrecomb::experiment::ExperimentError;
-use quadrecomb::experiment::config::{
+use quadrecomb::internals::experiment::ExperimentError;
+use quadrecomb::internals::experiment::config::{
     ConfigError, DEFAULT_SEED, MAX_HORIZONS, MAX_RUNS, SizeError, SweepConfig, SweepRequest,
 };
-use quadrecomb::experiment::manifest::Shard;
-use quadrecomb::experiment::sweep;
-use quadrecomb::gpu::Backend;
+use quadrecomb::internals::experiment::manifest::Shard;
+use quadrecomb::internals::experiment::sweep;
+use quadrecomb::internals::gpu::Backend;
 
 use super::BadInput;
 use super::errors::EXIT_INTERRUPTED;
@@ -156,7 +156,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         && !meta.is_dir()
     {
         return Err(ExperimentError::NotADirectory {
-            kind: quadrecomb::mesh::file_kind(&meta).to_string(),
+            kind: quadrecomb::internals::mesh::file_kind(&meta).to_string(),
             dir: out,
         }
         .into());
@@ -221,15 +221,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         manifest.backend
     );
     if !args.no_report && manifest.shard.is_none() {
-        let paths = quadrecomb::report::write(&out, &quadrecomb::report::ReportOptions::default())
-            .with_context(|| {
-                format!(
-                    "the sweep's results are complete in {}, but writing its report failed \
+        let paths = quadrecomb::internals::report::write(
+            &out,
+            &quadrecomb::internals::report::ReportOptions::default(),
+        )
+        .with_context(|| {
+            format!(
+                "the sweep's results are complete in {}, but writing its report failed \
                      (retry with `quadrecomb report {}`)",
-                    out.display(),
-                    out.display()
-                )
-            })?;
+                out.display(),
+                out.display()
+            )
+        })?;
         eprintln!("sweep: report in {}", paths.markdown.display());
     }
     Ok(ExitCode::SUCCESS)

@@ -4,10 +4,10 @@
 //!
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! use quadrecomb::{mesh, quality::CandidateTable, search::{self, Algo}};
-//! let mesh = mesh::load("sphere")?;
+//! use quadrecomb::{Algo, CandidateTable, Searcher};
+//! let mesh = quadrecomb::load("sphere")?;
 //! let table = CandidateTable::build(&mesh);
-//! let mut searcher = search::Searcher::new(&mesh, &table);
+//! let mut searcher = Searcher::new(&mesh, &table);
 //! for seed in 0..4 {
 //!     let out = searcher.run(Algo::Selective { horizon: 3 }, seed);
 //!     println!("{} quads, quality {:.2}", out.quads, out.quality);

@@ -726,7 +726,7 @@ fn report_escapes_mesh_names_and_keeps_figures_apart() {
 /// (it was reported at the `$Nodes` header line).
 #[test]
 fn a_duplicate_node_tag_is_reported_on_its_own_line() {
-    use quadrecomb::mesh::msh::read_bytes;
+    use quadrecomb::internals::mesh::msh::read_bytes;
     let edit = |file: &str, line: usize, text: &str| -> Vec<u8> {
         let s =
             std::fs::read_to_string(crate::util::repo_path(&format!("tests/data/{file}"))).unwrap();
@@ -760,7 +760,7 @@ fn a_flat_triangle_is_not_called_zero_area() {
              $EndNodes\n$Elements\n1\n1 2 2 0 1 1 2 3\n$EndElements\n"
         )
     };
-    let err = quadrecomb::mesh::msh::read_bytes("n.msh", mesh("1e200 0 0").as_bytes())
+    let err = quadrecomb::internals::mesh::msh::read_bytes("n.msh", mesh("1e200 0 0").as_bytes())
         .unwrap_err()
         .to_string();
     assert!(!err.contains("zero area"), "{err}");
@@ -768,7 +768,7 @@ fn a_flat_triangle_is_not_called_zero_area() {
         err.contains("flat to within rounding: its height is about 1e-400 times its longest edge"),
         "{err}"
     );
-    let err = quadrecomb::mesh::msh::read_bytes("z.msh", mesh("0 2e-200 0").as_bytes())
+    let err = quadrecomb::internals::mesh::msh::read_bytes("z.msh", mesh("0 2e-200 0").as_bytes())
         .unwrap_err()
         .to_string();
     assert!(err.contains("degenerate (zero area)"), "{err}");
@@ -913,14 +913,16 @@ fn fuzz_report_and_merge_never_panic() {
         let (tx, rx) = std::sync::mpsc::channel();
         let d = dir.clone();
         std::thread::spawn(move || {
-            let opts = quadrecomb::report::ReportOptions {
+            let opts = quadrecomb::internals::report::ReportOptions {
                 pictures: false,
                 ..Default::default()
             };
             let r = std::panic::catch_unwind(|| {
-                let report = quadrecomb::report::write(&d, &opts).is_ok();
-                let merge =
-                    quadrecomb::experiment::merge::merge(std::slice::from_ref(&d), &d.join("m"));
+                let report = quadrecomb::internals::report::write(&d, &opts).is_ok();
+                let merge = quadrecomb::internals::experiment::merge::merge(
+                    std::slice::from_ref(&d),
+                    &d.join("m"),
+                );
                 (report, merge.is_ok())
             });
             let _ = tx.send(r);

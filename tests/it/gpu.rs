@@ -6,11 +6,11 @@
 //! when `CI` is set: then they fail.
 
 use crate::util::{SEED, repo_path};
-use quadrecomb::gpu::{
+use quadrecomb::internals::gpu::{
     self, Backend, Batch, Evaluator, Kernel, KernelOptions, Layout, layout::Vertex,
 };
-use quadrecomb::mesh::{Mesh, MeshData};
-use quadrecomb::quality::{self, CandidateTable};
+use quadrecomb::internals::mesh::{Mesh, MeshData};
+use quadrecomb::internals::quality::{self, CandidateTable};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::PI;
@@ -258,7 +258,7 @@ fn jittered_grid_mesh(n: u32, jitter: f64, z: impl Fn(f64, f64) -> f64, seed: u6
 }
 
 fn icosphere(subdiv: u32) -> Mesh {
-    quadrecomb::mesh::generate::icosphere(subdiv)
+    quadrecomb::internals::mesh::generate::icosphere(subdiv)
 }
 
 fn mapped(m: &Mesh, f: impl Fn([f64; 3]) -> [f64; 3]) -> Mesh {
@@ -299,7 +299,7 @@ fn device_matches_f64_on_generated_and_builtin_meshes() {
         ),
     ];
     for name in ["borouchaki", "sphere"] {
-        match quadrecomb::mesh::load(name) {
+        match quadrecomb::internals::mesh::load(name) {
             Ok(m) => meshes.push((format!("built-in {name}"), m)),
             Err(e) => eprintln!("NOTE: built-in mesh {name} not tested: it does not load ({e})"),
         }

@@ -2,8 +2,8 @@
 //! every bad input through the CLI, and a seeded mutation fuzzer over the MSH reader.
 
 use crate::util::{SEED, gmsh_available, python, python_module_available, repo_path, run_in};
-use quadrecomb::mesh::{self, Mesh, MeshError, ReadError, Recombined, msh, vtu};
-use quadrecomb::quality::{self, CandidateTable};
+use quadrecomb::internals::mesh::{self, Mesh, MeshError, ReadError, Recombined, msh, vtu};
+use quadrecomb::internals::quality::{self, CandidateTable};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeSet;

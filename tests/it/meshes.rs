@@ -2,10 +2,10 @@
 //! icosphere), through the library and the `generate` subcommand.
 
 use crate::util::{SEED, gmsh_available, python, repo_path, run_in};
-use quadrecomb::mesh::generate::{
+use quadrecomb::internals::mesh::generate::{
     self, GenerateError, GridSpec, MAX_SUBDIVISIONS, grid, icosphere, icosphere_with_triangles,
 };
-use quadrecomb::mesh::{Mesh, NONE, builtin};
+use quadrecomb::internals::mesh::{Mesh, NONE, builtin};
 use std::collections::HashSet;
 
 /// V - E + F over the triangles.
@@ -139,7 +139,7 @@ fn builtin_meshes_load_by_name() {
         ("borouchaki", 34_456, 17_584, 0, true),
         ("sphere", 2_104, 1_054, 2, false),
     ] {
-        let mesh = checked(quadrecomb::mesh::load(name).expect(name));
+        let mesh = checked(quadrecomb::internals::mesh::load(name).expect(name));
         assert_eq!(mesh.num_triangles(), triangles, "{name}");
         assert_eq!(mesh.vertices.len(), vertices, "{name}");
         assert_eq!(mesh.surfaces(), vec![1], "{name}");
@@ -669,7 +669,7 @@ fn cli_generate_grid_writes_the_library_grid() {
     b.sort_unstable();
     assert_eq!(a, b);
     // Read back by the library: same coordinates (exactly) per node, same topology.
-    let back = checked(quadrecomb::mesh::msh::read(&dir.path().join("g.msh")).unwrap());
+    let back = checked(quadrecomb::internals::mesh::msh::read(&dir.path().join("g.msh")).unwrap());
     let by_id = |m: &Mesh| {
         let mut v: Vec<(u64, [f64; 3])> = m
             .vertex_ids

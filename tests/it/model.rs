@@ -4,9 +4,9 @@
 //! Python API (and meshio), not our reader.
 
 use crate::util::{gmsh_available, python, repo_path};
-use quadrecomb::mesh::{self, Mesh, Recombined, msh};
-use quadrecomb::quality::{self, CandidateTable, Rule};
-use quadrecomb::search::{self, Algo};
+use quadrecomb::internals::mesh::{self, Mesh, Recombined, msh};
+use quadrecomb::internals::quality::{self, CandidateTable, Rule};
+use quadrecomb::internals::search::{self, Algo};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

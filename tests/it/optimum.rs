@@ -2,9 +2,9 @@
 //! graphs and generated meshes, the dual certificate, the CLI, and the reference values.
 
 use crate::util::{SEED, run_in};
-use quadrecomb::mesh::{Mesh, MeshData};
-use quadrecomb::quality::CandidateTable;
-use quadrecomb::search::optimum::{self, blossom};
+use quadrecomb::internals::mesh::{Mesh, MeshData};
+use quadrecomb::internals::quality::CandidateTable;
+use quadrecomb::internals::search::optimum::{self, blossom};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -273,7 +273,7 @@ fn builtin_reference_values() {
         ("sphere", 678.81, None),
         ("borouchaki", 13183.64, Some(34456)),
     ] {
-        let mesh = match quadrecomb::mesh::load(name) {
+        let mesh = match quadrecomb::internals::mesh::load(name) {
             Ok(m) => m,
             Err(e) => {
                 eprintln!(
@@ -417,7 +417,8 @@ fn cli_writes_the_optimal_quad_mesh() {
         String::from_utf8_lossy(&out.stderr)
     );
     let path = dir.path().join("opt.msh");
-    let file = quadrecomb::mesh::msh::parse(&path, &std::fs::read(&path).unwrap()).unwrap();
+    let file =
+        quadrecomb::internals::mesh::msh::parse(&path, &std::fs::read(&path).unwrap()).unwrap();
     // All 2,104 triangles of the built-in sphere pair up: 1,052 quads, no triangle left.
     assert_eq!(
         (file.data.quads.len(), file.data.triangles.len()),

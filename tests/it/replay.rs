@@ -4,8 +4,8 @@
 //! is refused with a message and writes nothing.
 
 use crate::util::{SEED, gmsh_available, python, run_in};
-use quadrecomb::experiment::record::RunRecord;
-use quadrecomb::experiment::store;
+use quadrecomb::internals::experiment::record::RunRecord;
+use quadrecomb::internals::experiment::store;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Output;

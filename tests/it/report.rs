@@ -3,12 +3,12 @@
 //! expected boxes), mesh pictures, and the `report` subcommand.
 
 use crate::util::{SEED, run_in};
-use quadrecomb::experiment::record::RunRecord;
-use quadrecomb::mesh::{Mesh, MeshData};
-use quadrecomb::quality::{CandidateTable, recombined};
-use quadrecomb::report::picture::{PictureOptions, mesh_svg};
-use quadrecomb::report::{self, ReportOptions};
-use quadrecomb::stats::compare::{
+use quadrecomb::internals::experiment::record::RunRecord;
+use quadrecomb::internals::mesh::{Mesh, MeshData};
+use quadrecomb::internals::quality::{CandidateTable, recombined};
+use quadrecomb::internals::report::picture::{PictureOptions, mesh_svg};
+use quadrecomb::internals::report::{self, ReportOptions};
+use quadrecomb::internals::stats::compare::{
     Magnitude, PMethod, Test, bootstrap_median_diff_ci, compare, holm, mann_whitney, signed_rank,
     vargha_delaney,
 };
@@ -267,8 +267,8 @@ fn record(
 /// deterministic value), and the tested comparisons keep their bootstrap seeds.
 #[test]
 fn single_runs_are_shown_as_differences_not_tests() {
-    use quadrecomb::report::Metric;
-    use quadrecomb::report::significance::Family;
+    use quadrecomb::internals::report::Metric;
+    use quadrecomb::internals::report::significance::Family;
     let runs = |algo: &str, h: Option<u32>, n: u32, q: f64, t: f64| -> Vec<RunRecord> {
         (0..n)
             .map(|i| {
@@ -362,7 +362,9 @@ fn synthetic_dir(dir: &Path, runs: u32, seed: u64, shift: f64) {
 
 /// Writes a manifest for the synthetic sphere sweep (optimum quality 950.0).
 fn synthetic_manifest(dir: &Path, runs: u32) {
-    use quadrecomb::experiment::manifest::{Machine, Manifest, MeshEntry, OptimumEntry, SweepSpec};
+    use quadrecomb::internals::experiment::manifest::{
+        Machine, Manifest, MeshEntry, OptimumEntry, SweepSpec,
+    };
     let hash = "0123456789abcdef0123456789abcdef".to_string();
     Manifest {
         version: "0.1.0".into(),
@@ -681,9 +683,14 @@ fn planar_picture_draws_every_quad_and_leftover() {
 /// below with its own faces and framed on the picture.
 #[test]
 fn picture_has_sub_pixel_faces_and_an_inset_of_the_densest_region() {
-    let mesh = quadrecomb::mesh::load("borouchaki").unwrap();
+    let mesh = quadrecomb::internals::mesh::load("borouchaki").unwrap();
     let table = CandidateTable::build(&mesh);
-    let out = quadrecomb::search::run(&mesh, &table, quadrecomb::search::Algo::Greedy, SEED);
+    let out = quadrecomb::internals::search::run(
+        &mesh,
+        &table,
+        quadrecomb::internals::search::Algo::Greedy,
+        SEED,
+    );
     let rec = recombined(&mesh, &table, &out.chosen);
     let opts = PictureOptions {
         inset: true,
@@ -817,15 +824,15 @@ fn report_command_writes_files_and_rejects_bad_input() {
 /// A results directory holding real runs of the built-in sphere (CPU-twin eta), with a
 /// manifest, as a sweep writes it. `tamper` changes the recorded quality of every run.
 fn real_sphere_dir(dir: &Path, tamper: f64) {
-    use quadrecomb::experiment::{mesh_hash, seed::eta_hash};
-    use quadrecomb::gpu::Evaluator;
-    use quadrecomb::search::{self, Algo};
-    let mesh = quadrecomb::mesh::load("sphere").unwrap();
+    use quadrecomb::internals::experiment::{mesh_hash, seed::eta_hash};
+    use quadrecomb::internals::gpu::Evaluator;
+    use quadrecomb::internals::search::{self, Algo};
+    let mesh = quadrecomb::internals::mesh::load("sphere").unwrap();
     let mut table = CandidateTable::topology_only(&mesh);
     Evaluator::cpu_twin()
         .fill(&mut [(&mesh, &mut table)])
         .unwrap();
-    let table = table.restrict(&mesh, quadrecomb::quality::Rule::default());
+    let table = table.restrict(&mesh, quadrecomb::internals::quality::Rule::default());
     let hash = mesh_hash(&mesh);
     let mut lines = Vec::new();
     for (algo, h) in [

@@ -4,9 +4,9 @@
 //! committed report, figures included.
 
 use crate::util::{repo_path, run_in};
-use quadrecomb::experiment::manifest::Manifest;
-use quadrecomb::experiment::record::RunRecord;
-use quadrecomb::experiment::{store, summary};
+use quadrecomb::internals::experiment::manifest::Manifest;
+use quadrecomb::internals::experiment::record::RunRecord;
+use quadrecomb::internals::experiment::{store, summary};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -143,7 +143,7 @@ fn committed_reports_regenerate_unchanged() {
         for f in ["runs.jsonl", "manifest.json"] {
             std::fs::copy(src.join(f), dir.join(f)).unwrap();
         }
-        let paths = quadrecomb::report::write(&dir, &Default::default()).unwrap();
+        let paths = quadrecomb::internals::report::write(&dir, &Default::default()).unwrap();
         let named = |p: &Path| {
             let text = std::fs::read_to_string(p).unwrap();
             text.replace(&dir.display().to_string(), &format!("results/{case}"))

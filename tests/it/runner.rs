@@ -2,9 +2,9 @@
 //! kill -9 and Ctrl-C then --resume, torn lines, merge checks, statistics.
 
 use crate::util::{SEED, bin, run_in};
-use quadrecomb::experiment::record::RunRecord;
-use quadrecomb::experiment::store;
-use quadrecomb::stats::describe::{BoxStats, quantile, sd};
+use quadrecomb::internals::experiment::record::RunRecord;
+use quadrecomb::internals::experiment::store;
+use quadrecomb::internals::stats::describe::{BoxStats, quantile, sd};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};

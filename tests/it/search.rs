@@ -3,10 +3,10 @@
 //! the uniform tree), and the `recombine` CLI.
 
 use crate::util::SEED;
-use quadrecomb::mesh::{Mesh, MeshData, NONE};
-use quadrecomb::quality::{CandidateTable, Rule};
-use quadrecomb::search::state::{State, naive_allowed};
-use quadrecomb::search::{self, Algo, Searcher};
+use quadrecomb::internals::mesh::{Mesh, MeshData, NONE};
+use quadrecomb::internals::quality::{CandidateTable, Rule};
+use quadrecomb::internals::search::state::{State, naive_allowed};
+use quadrecomb::internals::search::{self, Algo, Searcher};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -443,7 +443,7 @@ fn recombine_cli_prints_json_and_writes_meshes() {
     let pct = v["quality_pct"].as_f64().unwrap();
     assert!(pct > 90.0 && pct <= 100.0 + 1e-9, "{pct}");
     // Same seed, same run, through the library.
-    let mesh = quadrecomb::mesh::load("sphere").unwrap();
+    let mesh = quadrecomb::internals::mesh::load("sphere").unwrap();
     let table = CandidateTable::build(&mesh).restrict(&mesh, Rule::default());
     let lib = search::run(&mesh, &table, Algo::Selective { horizon: 2 }, 7);
     assert_eq!(lib.quads as u64, quads);

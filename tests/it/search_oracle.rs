@@ -15,9 +15,9 @@ mod walk;
 
 use meshes::{Diagonals, Grid, Surfaces};
 use naive::Naive;
-use quadrecomb::mesh::generate::{self, Corridor};
-use quadrecomb::mesh::{Mesh, MeshData, NONE};
-use quadrecomb::quality::CandidateTable;
+use quadrecomb::internals::mesh::generate::{self, Corridor};
+use quadrecomb::internals::mesh::{Mesh, MeshData, NONE};
+use quadrecomb::internals::quality::CandidateTable;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use walk::{Subject, WalkConfig, walk};

@@ -5,8 +5,8 @@
 mod bandwidth;
 
 use anyhow::Context;
-use quadrecomb::gpu::layout::LOCAL_QUAD_BYTES;
-use quadrecomb::gpu::{self, Batch, Kernel, KernelOptions, Layout, Timings, synthetic};
+use quadrecomb::internals::gpu::layout::LOCAL_QUAD_BYTES;
+use quadrecomb::internals::gpu::{self, Batch, Kernel, KernelOptions, Layout, Timings, synthetic};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -195,7 +195,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             use rayon::prelude::*;
             quads
                 .par_iter()
-                .map(|q| quadrecomb::quality::quad_eta(q.map(|v| vertices[v as usize])))
+                .map(|q| quadrecomb::internals::quality::quad_eta(q.map(|v| vertices[v as usize])))
                 .collect()
         };
 
@@ -229,7 +229,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             let s = Instant::now();
             let r64: Vec<f64> = quads
                 .iter()
-                .map(|q| quadrecomb::quality::quad_eta(q.map(|v| vertices[v as usize])))
+                .map(|q| quadrecomb::internals::quality::quad_eta(q.map(|v| vertices[v as usize])))
                 .collect();
             let e = s.elapsed().as_secs_f64();
             assert_eq!(r64.len(), c);

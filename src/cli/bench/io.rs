@@ -1,8 +1,8 @@
 //! `quadrecomb bench io`: parse, topology and candidate-table times (median of repetitions).
 
 use crate::cli::BadInput;
-use quadrecomb::mesh::{self, Mesh};
-use quadrecomb::quality::CandidateTable;
+use quadrecomb::internals::mesh::{self, Mesh};
+use quadrecomb::internals::quality::CandidateTable;
 use std::process::ExitCode;
 use std::time::Instant;
 

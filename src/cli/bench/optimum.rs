@@ -1,11 +1,11 @@
 //! `quadrecomb bench optimum`: time of the exact optimum on the built-in meshes and on
 //! generated jittered grids of growing size, with the fitted growth exponent and peak memory.
 
-use quadrecomb::mesh::generate::{self, GridSpec};
-use quadrecomb::mesh::{Mesh, MeshData};
-use quadrecomb::quality::CandidateTable;
-use quadrecomb::search::optimum;
-use quadrecomb::stats::describe::linear_fit;
+use quadrecomb::internals::mesh::generate::{self, GridSpec};
+use quadrecomb::internals::mesh::{Mesh, MeshData};
+use quadrecomb::internals::quality::CandidateTable;
+use quadrecomb::internals::search::optimum;
+use quadrecomb::internals::stats::describe::linear_fit;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::process::{Command, ExitCode};
@@ -47,7 +47,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "mesh", "triangles", "quads", "left", "quality", "wall_ms", "cpu_ms", "rss_B/tri"
     );
     for spec in &args.meshes {
-        match quadrecomb::mesh::load(spec) {
+        match quadrecomb::internals::mesh::load(spec) {
             Ok(mesh) => {
                 let (opt, t, cpu) = time(&mesh, args.repeat);
                 print_row(spec, &mesh, &opt, t, cpu, None);

@@ -5,8 +5,8 @@
 //! A child that fails (out of memory under a limit, say) is reported with its exit status.
 
 use crate::cli::BadInput;
-use quadrecomb::mesh::Recombined;
-use quadrecomb::mesh::generate::{self, Corridor, GridSpec};
+use quadrecomb::internals::mesh::Recombined;
+use quadrecomb::internals::mesh::generate::{self, Corridor, GridSpec};
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 
@@ -84,7 +84,7 @@ fn recombine(exe: &Path, mesh: &Path, algo: &str, horizon: u32) -> anyhow::Resul
 }
 
 /// The mesh of `shape` with about `n` triangles.
-fn build(shape: &str, n: usize) -> quadrecomb::mesh::Mesh {
+fn build(shape: &str, n: usize) -> quadrecomb::internals::mesh::Mesh {
     match shape {
         "grid" => generate::grid(GridSpec {
             triangles: n,
@@ -106,7 +106,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     }
     for a in &args.algos {
-        quadrecomb::search::Algo::from_name(a, args.horizon.max(1))
+        quadrecomb::internals::search::Algo::from_name(a, args.horizon.max(1))
             .map_err(|e| BadInput(format!("--algos: {e}")))?;
     }
     if args.max_triangles < 10_000 {
@@ -130,7 +130,7 @@ fn measure(args: &Args, exe: &Path, dir: &Path) -> anyhow::Result<ExitCode> {
     // What a process costs before any mesh: a run on the smallest mesh there is.
     let tiny = dir.join("tiny.msh");
     let mesh = generate::corridor(Corridor::Strip, 2, 0);
-    quadrecomb::mesh::msh::write(&tiny, &mesh, &Recombined::unrecombined(&mesh))?;
+    quadrecomb::internals::mesh::msh::write(&tiny, &mesh, &Recombined::unrecombined(&mesh))?;
     let base = recombine(exe, &tiny, "greedy", 1)?;
     println!(
         "peak RSS of `quadrecomb recombine MESH --algo A --no-optimum` (child processes); \
@@ -147,7 +147,11 @@ fn measure(args: &Args, exe: &Path, dir: &Path) -> anyhow::Result<ExitCode> {
         for shape in &args.shapes {
             let mesh = build(shape, n);
             let path = dir.join(format!("{shape}-{n}.msh"));
-            quadrecomb::mesh::msh::write(&path, &mesh, &Recombined::unrecombined(&mesh))?;
+            quadrecomb::internals::mesh::msh::write(
+                &path,
+                &mesh,
+                &Recombined::unrecombined(&mesh),
+            )?;
             let nt = mesh.num_triangles();
             drop(mesh);
             for algo in &args.algos {

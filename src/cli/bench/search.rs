@@ -2,12 +2,12 @@
 //! per triangle of the selective tree on generated grids of growing size.
 
 use crate::cli::BadInput;
-use quadrecomb::mesh::{
+use quadrecomb::internals::mesh::{
     self,
     generate::{self, GridSpec},
 };
-use quadrecomb::quality::CandidateTable;
-use quadrecomb::search::{Algo, Searcher, optimum};
+use quadrecomb::internals::quality::CandidateTable;
+use quadrecomb::internals::search::{Algo, Searcher, optimum};
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]

@@ -11,9 +11,9 @@ fn buckets(state: &mut State<'_>) -> Option<[Vec<u32>; 3]> {
     Subject::buckets(state)
 }
 use crate::util::SEED;
-use quadrecomb::mesh::{Mesh, NONE};
-use quadrecomb::quality::CandidateTable;
-use quadrecomb::search::state::State;
+use quadrecomb::internals::mesh::{Mesh, NONE};
+use quadrecomb::internals::quality::CandidateTable;
+use quadrecomb::internals::search::state::State;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -2,7 +2,7 @@
 //! jittered grids (diagonals, holes, dropped triangles, input quads, surface tags), icospheres
 //! and random triangulations (random point insertions and edge flips).
 
-use quadrecomb::mesh::{Mesh, MeshData};
+use quadrecomb::internals::mesh::{Mesh, MeshData};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashMap;

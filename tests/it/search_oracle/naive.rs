@@ -14,8 +14,8 @@
 //!   triangles both remain;
 //! - `P_k` is the set of remaining triangles that take part in exactly k allowed actions.
 
-use quadrecomb::mesh::{Mesh, NONE};
-use quadrecomb::quality::CandidateTable;
+use quadrecomb::internals::mesh::{Mesh, NONE};
+use quadrecomb::internals::quality::CandidateTable;
 use std::cell::RefCell;
 
 /// Remaining triangles with an undo log, and the criterion computed from scratch on demand.

@@ -12,9 +12,9 @@ use super::meshes::{self, Diagonals, Grid};
 use super::naive::Naive;
 use super::sample_meshes;
 use crate::util::SEED;
-use quadrecomb::mesh::{Mesh, NONE};
-use quadrecomb::quality::CandidateTable;
-use quadrecomb::search::{Algo, Searcher};
+use quadrecomb::internals::mesh::{Mesh, NONE};
+use quadrecomb::internals::quality::CandidateTable;
+use quadrecomb::internals::search::{Algo, Searcher};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -6,9 +6,9 @@ use super::walk::{Subject, WalkConfig, WalkStats, walk};
 use crate::util::SEED;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
-use quadrecomb::mesh::Mesh;
-use quadrecomb::quality::{CandidateTable, Rule};
-use quadrecomb::search::state::State;
+use quadrecomb::internals::mesh::Mesh;
+use quadrecomb::internals::quality::{CandidateTable, Rule};
+use quadrecomb::internals::search::state::State;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -366,11 +366,11 @@ fn sampled_walk(name: &str, mesh: &Mesh, seed: u64, sample: usize, max_depth: us
         let mut cands: Vec<u32> = (0..sample).map(|_| rng.random_range(0..nc)).collect();
         for t in table.pairs[last as usize] {
             for &u in &mesh.topology.neighbours[t as usize] {
-                if u != quadrecomb::mesh::NONE {
+                if u != quadrecomb::internals::mesh::NONE {
                     cands.extend(
                         table.by_triangle[u as usize]
                             .iter()
-                            .filter(|&&c| c != quadrecomb::mesh::NONE),
+                            .filter(|&&c| c != quadrecomb::internals::mesh::NONE),
                     );
                 }
             }
@@ -387,7 +387,9 @@ fn sampled_walk(name: &str, mesh: &Mesh, seed: u64, sample: usize, max_depth: us
                 let expected = if oracle.is_remaining(t) {
                     table.by_triangle[t as usize]
                         .iter()
-                        .filter(|&&d| d != quadrecomb::mesh::NONE && oracle.is_allowed(d))
+                        .filter(|&&d| {
+                            d != quadrecomb::internals::mesh::NONE && oracle.is_allowed(d)
+                        })
                         .count() as u32
                 } else {
                     0
@@ -450,7 +452,7 @@ fn sampled_walk(name: &str, mesh: &Mesh, seed: u64, sample: usize, max_depth: us
     }
     for t in 0..mesh.num_triangles() as u32 {
         for &c in &table.by_triangle[t as usize] {
-            if c != quadrecomb::mesh::NONE {
+            if c != quadrecomb::internals::mesh::NONE {
                 assert!(
                     !oracle.is_allowed(c),
                     "{name}: the state allows nothing, the oracle allows {c}"
@@ -468,7 +470,7 @@ fn soak_state_matches_oracle() {
     for (name, mesh) in sample_meshes(SEED ^ 0xABCD) {
         check_mesh(&name, &mesh, 0..6, WalkConfig::default());
     }
-    let sphere = quadrecomb::mesh::load("sphere").expect("built-in sphere");
+    let sphere = quadrecomb::internals::mesh::load("sphere").expect("built-in sphere");
     for s in 0..2 {
         sampled_walk("sphere", &sphere, SEED ^ s, 40, 8);
     }

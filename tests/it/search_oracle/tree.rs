@@ -8,9 +8,9 @@ use super::naive::Naive;
 use super::sample_meshes;
 use super::walk::compare;
 use crate::util::SEED;
-use quadrecomb::mesh::{Mesh, NONE};
-use quadrecomb::quality::{CandidateTable, Rule};
-use quadrecomb::search::state::State;
+use quadrecomb::internals::mesh::{Mesh, NONE};
+use quadrecomb::internals::quality::{CandidateTable, Rule};
+use quadrecomb::internals::search::state::State;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -2,8 +2,8 @@
 //! answer of the state under test checked against the naive oracle after every step.
 
 use super::naive::{Naive, Verdicts};
-use quadrecomb::mesh::Mesh;
-use quadrecomb::quality::CandidateTable;
+use quadrecomb::internals::mesh::Mesh;
+use quadrecomb::internals::quality::CandidateTable;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::fmt::Write as _;

@@ -3,8 +3,8 @@
 //! (`shaders/stream_copy.wgsl`, [`stream_bandwidth`]). Benchmarks only: the evaluator never
 //! measures its device.
 
-use quadrecomb::gpu::timing::{Timestamps, checked, timed_dispatches, wait};
-use quadrecomb::gpu::{GpuError, shader};
+use quadrecomb::internals::gpu::timing::{Timestamps, checked, timed_dispatches, wait};
+use quadrecomb::internals::gpu::{GpuError, shader};
 use std::borrow::Cow;
 use std::time::{Duration, Instant};
 

@@ -149,7 +149,9 @@ const ELEMENT_TYPES: [(i64, usize, u8, &str); 135] = [
 
 /// The nodes, dimension and name of Gmsh element type `etype`; `None` for a number Gmsh
 /// does not know.
-pub(in crate::mesh::msh) fn element_type(etype: i64) -> Option<(usize, u8, &'static str)> {
+pub(in crate::internals::mesh::msh) fn element_type(
+    etype: i64,
+) -> Option<(usize, u8, &'static str)> {
     let i = ELEMENT_TYPES.binary_search_by_key(&etype, |e| e.0).ok()?;
     let (_, nodes, dim, name) = ELEMENT_TYPES[i];
     Some((nodes, dim, name))
