@@ -50,10 +50,12 @@ pub struct Args {
     /// Horizons of selective and uniform: a range A..B (inclusive), a list 1,3,5, or one value.
     #[arg(long, value_name = "H", default_value = "1..10", value_parser = parse_horizons)]
     horizons: Horizons,
-    /// Runs per (mesh, selective/uniform, horizon).
+    /// Runs per (mesh, selective, horizon): the randomized configurations.
     #[arg(long, default_value_t = 128)]
     runs: u32,
-    /// Runs per mesh of greedy and greedy-nocrit (deterministic: ties are broken by index).
+    /// Runs of each deterministic configuration: greedy and greedy-nocrit per mesh (ties are
+    /// broken by index), uniform per horizon (it draws nothing at random). More than 1 only
+    /// repeats the same run, for its timings.
     #[arg(long, default_value_t = 1)]
     baseline_runs: u32,
     /// Worker threads (default: every core).
@@ -62,8 +64,11 @@ pub struct Args {
     /// Base seed; every run's seed is derived from it and the run's identity.
     #[arg(long, default_value_t = DEFAULT_SEED)]
     seed: u64,
-    /// Who computes the quad qualities.
-    #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
+    /// Who computes the quad qualities. The default, the CPU twin of the kernel, gives the same
+    /// bits on every machine, so a sweep's records are the same everywhere (the committed
+    /// results/ are reproduced exactly); `gpu` or `auto` evaluate on a device, whose last-bit
+    /// differences can break ties differently in individual runs.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
     backend: BackendArg,
     #[command(flatten)]
     rule: super::RuleArgs,
@@ -242,6 +247,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 fn config_error(e: ConfigError) -> BadInput {
     BadInput(match e {
         ConfigError::ZeroRuns => "--runs must be at least 1".into(),
+        ConfigError::SeedTooLarge(seed) => format!(
+            "--seed {seed} is above 2^53 - 1 = {}: records hold it as a JSON number, which jq \
+             and pandas would read rounded (another run); choose a smaller seed",
+            quadrecomb::internals::experiment::seed::MAX_EXACT_SEED
+        ),
         ConfigError::ZeroBaselineRuns(algos) => format!(
             "--baseline-runs must be at least 1 (it is the number of runs of {})",
             algos.join(", ")

@@ -71,7 +71,7 @@ impl Default for SweepRequest {
             baseline_runs: 1,
             seed: DEFAULT_SEED,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
-            backend: Backend::Auto,
+            backend: Backend::Cpu,
             rule: Rule::default(),
             out: PathBuf::from("results/borouchaki"),
             resume: false,
@@ -114,6 +114,13 @@ pub enum ConfigError {
     /// Zero worker threads.
     #[error("the worker threads must be at least 1")]
     ZeroThreads,
+    /// A base seed above 2^53 - 1, which JSON readers that hold numbers as doubles (jq,
+    /// pandas with pyarrow) would read as another seed.
+    #[error(
+        "base seed {0} is above 2^53 - 1 = {max}, which jq and pandas would read rounded",
+        max = super::seed::MAX_EXACT_SEED
+    )]
+    SeedTooLarge(u64),
     /// More horizons or runs than a sweep holds.
     #[error(transparent)]
     TooLarge(#[from] SizeError),
@@ -203,9 +210,13 @@ impl SweepConfig {
                 return Err(ConfigError::ZeroRuns);
             }
         }
-        // The baseline runs count the greedy runs (the optimum always runs once).
+        if r.seed > super::seed::MAX_EXACT_SEED {
+            return Err(ConfigError::SeedTooLarge(r.seed));
+        }
+        // The baseline runs count the runs of the deterministic configurations (the optimum
+        // always runs once).
         let baselines: Vec<String> = (r.algos.iter())
-            .filter(|a| matches!(a.as_str(), "greedy" | "greedy-nocrit"))
+            .filter(|a| matches!(a.as_str(), "greedy" | "greedy-nocrit" | "uniform"))
             .cloned()
             .collect();
         if r.baseline_runs == 0 && !baselines.is_empty() {
@@ -316,6 +327,7 @@ impl SweepConfig {
             seed: c.seed,
             min_eta: c.rule.min_eta(),
             allow_invalid: c.rule.allows_invalid(),
+            plan_version: super::seed::PLAN_VERSION,
         }
     }
 
@@ -360,6 +372,11 @@ mod tests {
             Err(ConfigError::ZeroHorizon)
         );
         assert_eq!(with(|r| r.runs = 0), Err(ConfigError::ZeroRuns));
+        assert_eq!(
+            with(|r| r.seed = 1 << 53),
+            Err(ConfigError::SeedTooLarge(1 << 53))
+        );
+        assert!(with(|r| r.seed = (1 << 53) - 1).is_ok());
         assert_eq!(
             with(|r| r.baseline_runs = 0),
             Err(ConfigError::ZeroBaselineRuns(strings(&[

@@ -59,6 +59,18 @@ pub struct SweepSpec {
     /// existed read as such).
     #[serde(default = "super::record::paper_literal")]
     pub allow_invalid: bool,
+    /// How the run list and the seeds are made ([`super::seed::PLAN_VERSION`] for new
+    /// sweeps): version 1 (manifests without the field) derives 64-bit seeds and runs the
+    /// uniform tree `runs` times per horizon; version 2 keeps seeds below 2^53 and runs
+    /// every deterministic configuration (greedy, greedy-nocrit, uniform) `baseline_runs`
+    /// times.
+    #[serde(default = "plan_version_1")]
+    pub plan_version: u32,
+}
+
+/// The plan version of manifests written before the field existed.
+fn plan_version_1() -> u32 {
+    1
 }
 
 impl SweepSpec {
@@ -313,6 +325,13 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     }
     if a.rule() != b.rule() {
         return Some(format!("rule {} vs {}", a.rule(), b.rule()));
+    }
+    if a.plan_version != b.plan_version {
+        return Some(format!(
+            "plan version {} vs {} (seeds and run lists of different quadrecomb releases: \
+             finish that sweep with the release that began it, or start a new one)",
+            a.plan_version, b.plan_version
+        ));
     }
     None
 }

@@ -9,6 +9,23 @@ pub fn has_horizon(algo: &str) -> bool {
     matches!(algo, "uniform" | "selective")
 }
 
+/// Algorithms that draw nothing at random: every run of one configuration is the same run
+/// (greedy and greedy-nocrit break ties by index, the uniform tree branches on every action,
+/// the optimum is exact).
+pub fn deterministic(algo: &str) -> bool {
+    matches!(algo, "greedy" | "greedy-nocrit" | "uniform" | "optimum")
+}
+
+/// Runs per configuration of `algo` (per horizon for the trees) under plan `version`.
+fn runs_of(algo: &str, version: u32, runs: u32, baseline_runs: u32) -> u32 {
+    match algo {
+        "optimum" => 1,
+        "uniform" if version >= 2 => baseline_runs,
+        a if has_horizon(a) => runs,
+        _ => baseline_runs,
+    }
+}
+
 /// One run to do.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Job {
@@ -36,7 +53,8 @@ impl Job {
     }
 }
 
-/// The number of runs [`plan`] makes, counted without making them (saturating).
+/// The number of runs [`plan`] makes under the current plan version, counted without making
+/// them (saturating).
 pub fn planned_runs(
     meshes: usize,
     algos: &[String],
@@ -44,12 +62,16 @@ pub fn planned_runs(
     runs: u32,
     baseline_runs: u32,
 ) -> u64 {
+    let version = super::seed::PLAN_VERSION;
     let per_mesh = algos
         .iter()
-        .map(|a| match a.as_str() {
-            "optimum" => 1,
-            a if has_horizon(a) => (horizons as u64).saturating_mul(u64::from(runs)),
-            _ => u64::from(baseline_runs),
+        .map(|a| {
+            let n = u64::from(runs_of(a, version, runs, baseline_runs));
+            if has_horizon(a) {
+                (horizons as u64).saturating_mul(n)
+            } else {
+                n
+            }
         })
         .fold(0u64, u64::saturating_add);
     per_mesh.saturating_mul(meshes as u64)
@@ -57,17 +79,17 @@ pub fn planned_runs(
 
 /// Every run of a sweep, in canonical order: by mesh, then algorithm (spec order), then
 /// horizon, then run index. `optimum` is one run per mesh; `greedy` and `greedy-nocrit` are
-/// `baseline_runs` runs; `uniform` and `selective` are `runs` runs per horizon.
+/// `baseline_runs` runs; `selective` is `runs` runs per horizon; `uniform`, deterministic, is
+/// `baseline_runs` runs per horizon (plan version 2; `runs` in version 1).
 pub fn plan(spec: &SweepSpec) -> Vec<Job> {
     let mut jobs = Vec::new();
     for (m, mesh) in spec.meshes.iter().enumerate() {
         for algo in &spec.algos {
-            let (horizons, runs): (Vec<Option<u32>>, u32) = match algo.as_str() {
-                "optimum" => (vec![None], 1),
-                a if has_horizon(a) => {
-                    (spec.horizons.iter().map(|&h| Some(h)).collect(), spec.runs)
-                }
-                _ => (vec![None], spec.baseline_runs),
+            let runs = runs_of(algo, spec.plan_version, spec.runs, spec.baseline_runs);
+            let horizons: Vec<Option<u32>> = if has_horizon(algo) {
+                spec.horizons.iter().map(|&h| Some(h)).collect()
+            } else {
+                vec![None]
             };
             for horizon in horizons {
                 for run in 0..runs {
@@ -76,7 +98,14 @@ pub fn plan(spec: &SweepSpec) -> Vec<Job> {
                         algo: algo.clone(),
                         horizon,
                         run,
-                        seed: derive_seed(spec.seed, &mesh.hash, algo, horizon, run),
+                        seed: derive_seed(
+                            spec.plan_version,
+                            spec.seed,
+                            &mesh.hash,
+                            algo,
+                            horizon,
+                            run,
+                        ),
                     });
                 }
             }
@@ -149,7 +178,30 @@ pub(crate) mod tests {
             seed: 9,
             min_eta: 0.0,
             allow_invalid: false,
+            plan_version: crate::experiment::seed::PLAN_VERSION,
         }
+    }
+
+    #[test]
+    fn the_uniform_tree_runs_once_per_horizon_from_plan_version_2() {
+        let mut s = spec();
+        s.algos = vec!["uniform".into(), "selective".into()];
+        let count = |s: &SweepSpec, algo: &str| plan(s).iter().filter(|j| j.algo == algo).count();
+        // Version 2: uniform, deterministic, like the baselines (2 runs per horizon here).
+        assert_eq!(count(&s, "uniform"), 2 * 3 * 2);
+        assert_eq!(count(&s, "selective"), 2 * 3 * 5);
+        assert_eq!(
+            planned_runs(2, &s.algos, 3, s.runs, s.baseline_runs),
+            plan(&s).len() as u64
+        );
+        // Version 1 (older manifests) keeps its run list, so those sweeps still resume.
+        s.plan_version = 1;
+        assert_eq!(count(&s, "uniform"), 2 * 3 * 5);
+        assert!(
+            plan(&s)
+                .iter()
+                .any(|j| j.seed > crate::experiment::seed::MAX_EXACT_SEED)
+        );
     }
 
     #[test]

@@ -383,6 +383,7 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
             seed: SEED,
             min_eta: 0.0,
             allow_invalid: false,
+            plan_version: 2,
         },
         backend: "cpu-twin".into(),
         backend_requested: "cpu".into(),
