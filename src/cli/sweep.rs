@@ -186,6 +186,24 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         shard: args.shard,
     })
     .map_err(config_error)?;
+    let fixed: Vec<&str> = (config.algos().iter())
+        .map(String::as_str)
+        .filter(|a| matches!(*a, "greedy" | "greedy-nocrit" | "uniform"))
+        .collect();
+    if !fixed.is_empty() && !args.quiet {
+        let n = config.baseline_runs();
+        eprintln!(
+            "sweep: {} deterministic (the same run whatever the seed): {n} run{} each{}, not \
+             --runs; --baseline-runs repeats them for timings",
+            fixed.join(", "),
+            if n == 1 { "" } else { "s" },
+            if fixed.contains(&"uniform") {
+                " (uniform: per horizon)"
+            } else {
+                ""
+            }
+        );
+    }
     let mut display = SweepDisplay::new(if args.quiet {
         ProgressMode::Quiet
     } else if args.plain {

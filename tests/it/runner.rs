@@ -639,3 +639,101 @@ fn shards_from_other_directories_merge_and_report_finds_the_mesh() {
         );
     }
 }
+
+/// Plan version 2: deterministic configurations run once (uniform once per horizon) and the
+/// sweep says so; seeds are below 2^53; the default backend is the CPU twin (also where a
+/// Vulkan adapter exists, as lavapipe does in CI); a version-1 directory is not resumed with
+/// the new recipe.
+#[test]
+fn deterministic_runs_once_seeds_fit_doubles_and_the_default_is_the_twin() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = run_in(
+        tmp.path(),
+        &[
+            "sweep",
+            "--mesh",
+            "sphere",
+            "--algo",
+            "uniform",
+            "selective",
+            "greedy",
+            "--horizons",
+            "1..2",
+            "--runs",
+            "3",
+            "--out",
+            "d",
+            "--no-report",
+            "--plain",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("uniform, greedy deterministic"), "{err}");
+    let text = std::fs::read_to_string(tmp.path().join("d/runs.jsonl")).unwrap();
+    let recs: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let count = |algo: &str| recs.iter().filter(|r| r["algo"] == algo).count();
+    assert_eq!(
+        (count("uniform"), count("selective"), count("greedy")),
+        (2, 6, 1)
+    );
+    for r in &recs {
+        let seed = r["seed"].as_u64().unwrap();
+        assert!(seed < 1 << 53, "seed {seed}");
+        assert_eq!(r["backend"], "cpu-twin");
+    }
+    let bad = run_in(
+        tmp.path(),
+        &[
+            "sweep",
+            "--mesh",
+            "sphere",
+            "--seed",
+            "9007199254740992",
+            "--out",
+            "e",
+        ],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("above 2^53 - 1"));
+    // A directory of plan version 1 (its manifest has no plan_version) is not resumed.
+    let manifest = tmp.path().join("d/manifest.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&manifest).unwrap()).unwrap();
+    m["spec"].as_object_mut().unwrap().remove("plan_version");
+    std::fs::write(&manifest, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+    let again = run_in(
+        tmp.path(),
+        &[
+            "sweep",
+            "--mesh",
+            "sphere",
+            "--algo",
+            "uniform",
+            "selective",
+            "greedy",
+            "--horizons",
+            "1..2",
+            "--runs",
+            "3",
+            "--out",
+            "d",
+            "--no-report",
+            "--resume",
+        ],
+    );
+    assert_eq!(
+        again.status.code(),
+        Some(4),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    assert!(String::from_utf8_lossy(&again.stderr).contains("plan version 2 vs 1"));
+}
