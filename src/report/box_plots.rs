@@ -67,13 +67,30 @@ pub(super) fn box_plots(
                          per horizon, branching factor alpha = 10^slope = {:.3}",
                         f.h_min, f.h_max, f.fit.slope, f.alpha
                     ));
+                    if f.fit.n < 3 {
+                        caption.push_str(
+                            " (a line through two points, which any two horizons fit exactly: \
+                             not a measured growth; sweep more horizons for one)",
+                        );
+                    }
                     if let Some(a) = entry.and_then(|g| g.all.as_ref()) {
                         caption.push_str(&format!(
                             " (over every horizon h = {}..{}: alpha = {:.3})",
                             a.h_min, a.h_max, a.alpha
                         ));
                     }
-                    caption.push_str("; the paper reports 1.33 on its Borouchaki mesh.");
+                    caption.push_str(match algo {
+                        "selective" => {
+                            "; the paper reports 1.33 for its selective tree on its \
+                                        Borouchaki mesh."
+                        }
+                        "uniform" => {
+                            "; the uniform tree branches on every allowed action, so \
+                                      its alpha is of the order of the actions per step, not \
+                                      comparable with the paper's 1.33 for the selective tree."
+                        }
+                        _ => ".",
+                    });
                 }
             }
             let stem = format!("{}-{}-{}", mesh_slug(mesh), slug(algo), metric.key());

@@ -483,6 +483,27 @@ fn report_names_every_configuration_and_draws_every_box() {
     assert!(md.contains("| 225.6 |"), "{md}");
     assert!(md.contains("different mesh"));
 
+    // The paper's branching factor is quoted for the selective tree only, and a fit through
+    // two horizons (uniform h = 1..2 here) is called what it is.
+    let uniform_time = (md.lines())
+        .find(|l| l.contains("uniform: time") && l.contains("branching factor"))
+        .unwrap_or_else(|| panic!("no uniform time caption in {md}"));
+    assert!(
+        uniform_time.contains("not comparable with the paper's 1.33"),
+        "{uniform_time}"
+    );
+    assert!(
+        uniform_time.contains("a line through two points"),
+        "{uniform_time}"
+    );
+    let selective_time = (md.lines())
+        .find(|l| l.contains("selective: time") && l.contains("branching factor"))
+        .unwrap();
+    assert!(selective_time.contains("the paper reports 1.33 for its selective tree"));
+    assert!(
+        !selective_time.contains("not comparable"),
+        "{selective_time}"
+    );
     // Figures: 3 box plots each for uniform and selective.
     assert_eq!(paths.figures.len(), 6, "{:?}", paths.figures);
     let mut boxes_seen = 0;
