@@ -38,10 +38,49 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
     err.chain().find_map(code).unwrap_or(EXIT_FAILURE)
 }
 
+/// A results directory the command cannot use as given, worded by the command with the
+/// user's own path (exit code [`EXIT_RESULTS_DIR`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UnusableResultsDir(pub String);
+
+/// Refuses, before any work, a results directory `--out DIR` that cannot be one: `dir` is a
+/// file, or lies under a file (`--out f/sub` named the internal `f/sub/optimum-cache` when
+/// the sweep failed to create it). Names the user's path and the file in the way.
+pub fn check_results_dir(dir: &std::path::Path) -> anyhow::Result<()> {
+    let existing = dir
+        .ancestors()
+        .filter(|a| !a.as_os_str().is_empty())
+        .find_map(|a| std::fs::metadata(a).ok().map(|m| (a, m)));
+    match existing {
+        Some((a, meta)) if !meta.is_dir() => {
+            let kind = quadrecomb::mesh::file_kind(&meta).to_string();
+            if a == dir {
+                return Err(ExperimentError::NotADirectory {
+                    dir: dir.to_path_buf(),
+                    kind,
+                }
+                .into());
+            }
+            Err(UnusableResultsDir(format!(
+                "--out {}: {} is {kind}, not a directory, so no results directory can be made \
+                 under it; choose another --out",
+                dir.display(),
+                a.display()
+            ))
+            .into())
+        }
+        _ => Ok(()),
+    }
+}
+
 /// The code one cause decides, if it decides one.
 fn code(e: &(dyn Error + 'static)) -> Option<u8> {
     if e.is::<BadInput>() {
         return Some(EXIT_USAGE);
+    }
+    if e.is::<UnusableResultsDir>() {
+        return Some(EXIT_RESULTS_DIR);
     }
     if e.is::<quadrecomb::mesh::ReadError>() || e.is::<quadrecomb::mesh::MeshError>() {
         return Some(EXIT_BAD_INPUT);

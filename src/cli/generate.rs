@@ -75,7 +75,8 @@ struct IcosphereArgs {
     /// Subdivision level s (0 to 10): 20 * 4^s triangles.
     #[arg(long)]
     subdivisions: Option<u32>,
-    /// Target number of triangles: the level whose count is closest.
+    /// Target number of triangles (at least 1): the level whose count (20 * 4^s) is closest;
+    /// the "wrote" line says so when it differs.
     #[arg(long)]
     triangles: Option<usize>,
     /// Output file (.msh, written as MSH 4.1 ASCII).
@@ -105,6 +106,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Shape::Icosphere(a) => {
             let s = match (a.subdivisions, a.triangles) {
                 (Some(s), _) => s,
+                (None, Some(0)) => {
+                    return Err(BadInput(
+                        "--triangles 0: an icosphere has at least 20 triangles (0 \
+                         subdivisions); give a target of 1 or more, or --subdivisions"
+                            .into(),
+                    )
+                    .into());
+                }
                 (None, Some(n)) => {
                     let largest = 20usize << (2 * MAX_SUBDIVISIONS);
                     if n > 2 * largest {
@@ -125,11 +134,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .into());
             }
             check_output(&a.output)?;
-            (
-                generate::icosphere(s),
-                format!("icosphere, {s} subdivisions"),
-                a.output,
-            )
+            let made = 20usize << (2 * s);
+            // --triangles picks the closest level: say so when the count is not the target.
+            let what = match a.triangles {
+                Some(n) if a.subdivisions.is_none() && n != made => format!(
+                    "icosphere, {s} subdivisions: 20 * 4^{s} is the closest count to \
+                     --triangles {n}"
+                ),
+                _ => format!("icosphere, {s} subdivisions"),
+            };
+            (generate::icosphere(s), what, a.output)
         }
         Shape::Strip(a) => corridor(Corridor::Strip, a)?,
         Shape::Spiral(a) => corridor(Corridor::Spiral, a)?,

@@ -20,6 +20,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    super::errors::check_results_dir(&args.out)?;
     let merged = merge(&args.dirs, &args.out)?;
     eprintln!(
         "merge: {} runs from {} directories into {}",

@@ -140,7 +140,8 @@ pub fn check_mesh_output(path: Option<&std::path::Path>) -> Result<(), BadInput>
 }
 
 /// The part of [`check_mesh_output`] that does not look at the extension: `path` names a
-/// file (not a directory, no trailing slash) whose directory exists.
+/// file (not a directory, no trailing slash) in a directory that exists and takes a new file
+/// (tried by creating and removing a temporary one, as the atomic writer will).
 pub fn check_output_place(p: &std::path::Path) -> Result<(), BadInput> {
     let bad = |why: String| Err(BadInput(format!("output {}: {why}", p.display())));
     if p.is_dir() || p.as_os_str().to_string_lossy().ends_with('/') {
@@ -150,7 +151,19 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), BadInput> {
     match dir {
         Some(d) if d.exists() && !d.is_dir() => bad(format!("{} is not a directory", d.display())),
         Some(d) if !d.exists() => bad(format!("directory {} does not exist", d.display())),
-        _ => Ok(()),
+        _ => {
+            let d = dir.unwrap_or(std::path::Path::new("."));
+            match tempfile::Builder::new()
+                .prefix(".quadrecomb-")
+                .tempfile_in(d)
+            {
+                Ok(_) => Ok(()),
+                Err(e) => bad(format!(
+                    "directory {} does not take a new file ({e}); choose another -o",
+                    d.display()
+                )),
+            }
+        }
     }
 }
 

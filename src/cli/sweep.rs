@@ -5,7 +5,6 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context;
-use quadrecomb::experiment::ExperimentError;
 use quadrecomb::experiment::config::{
     ConfigError, DEFAULT_SEED, MAX_HORIZONS, MAX_RUNS, SizeError, SweepConfig, SweepRequest,
 };
@@ -86,7 +85,7 @@ pub struct Args {
     /// Progress as plain lines even on a terminal.
     #[arg(long, conflicts_with = "quiet")]
     plain: bool,
-    /// No progress output.
+    /// Quiet: only errors and warnings on stderr (no progress, no notices, no summary).
     #[arg(long, short)]
     quiet: bool,
 }
@@ -152,15 +151,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         };
         PathBuf::from("results").join(name)
     });
-    if let Ok(meta) = std::fs::metadata(&out)
-        && !meta.is_dir()
-    {
-        return Err(ExperimentError::NotADirectory {
-            kind: quadrecomb::mesh::file_kind(&meta).to_string(),
-            dir: out,
-        }
-        .into());
-    }
+    super::errors::check_results_dir(&out)?;
     let config = SweepConfig::new(SweepRequest {
         meshes,
         algos: if args.algos.is_empty() {
@@ -212,14 +203,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
         return Ok(ExitCode::from(EXIT_INTERRUPTED));
     }
-    eprintln!(
-        "sweep: {} runs done ({} new, {} already recorded) into {}{shard}; backend {}",
-        report.planned,
-        report.done_now,
-        report.already,
-        out.display(),
-        manifest.backend
-    );
+    if !args.quiet {
+        eprintln!(
+            "sweep: {} runs done ({} new, {} already recorded) into {}{shard}; backend {}",
+            report.planned,
+            report.done_now,
+            report.already,
+            out.display(),
+            manifest.backend
+        );
+    }
     if !args.no_report && manifest.shard.is_none() {
         let paths = quadrecomb::report::write(&out, &quadrecomb::report::ReportOptions::default())
             .with_context(|| {
@@ -230,7 +223,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     out.display()
                 )
             })?;
-        eprintln!("sweep: report in {}", paths.markdown.display());
+        if !args.quiet {
+            eprintln!("sweep: report in {}", paths.markdown.display());
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

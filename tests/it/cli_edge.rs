@@ -113,7 +113,8 @@ fn exit_4_results_directory() {
 }
 
 /// The library's notices reach stderr through the command: the backend `auto` picked, once,
-/// and the resume; `-q` keeps the backend line (as before) but not the progress or resume.
+/// and the resume; `-q` keeps only warnings: the backend line where it is a fallback (no GPU
+/// here: lavapipe or the CPU twin), not the progress, the resume or the summary.
 #[test]
 fn notices_reach_stderr_through_the_command() {
     let tmp = tempfile::tempdir().unwrap();
@@ -137,10 +138,11 @@ fn notices_reach_stderr_through_the_command() {
     args.push("-q");
     args.retain(|a| *a != "--plain");
     let quiet = stderr(&run_in(tmp.path(), &args));
-    assert!(quiet.starts_with("quality backend: "), "{quiet}");
+    let gpu = backend[0].starts_with("quality backend: using the GPU");
+    assert_eq!(quiet.starts_with("quality backend: "), !gpu, "{quiet}");
     assert!(
-        !quiet.contains("resuming") && !quiet.contains("1/1 runs"),
-        "{quiet}"
+        quiet.lines().all(|l| l.starts_with("quality backend: ")),
+        "-q: warnings only: {quiet}"
     );
 }
 
@@ -188,4 +190,167 @@ fn library_files(src: &Path, dir: &Path, out: &mut Vec<std::path::PathBuf>) {
             out.push(path);
         }
     }
+}
+
+/// Sizes too small to mean anything are refused before any work, with the limit: `bench
+/// optimum --sizes 0` panicked (exit 101), `--lattice-sizes 2` timed a 2-triangle lattice,
+/// `bench search --max-grid 1` printed an empty table, `generate icosphere --triangles 0`
+/// wrote 20 triangles without a word.
+#[test]
+fn sizes_too_small_are_refused_with_the_limit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let no_work = |args: &[&str], expect: &str| {
+        let o = run_in(tmp.path(), args);
+        assert!(o.stdout.is_empty(), "{args:?}: refused before any work");
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.starts_with("error: ") && err.contains(expect), "{err}");
+    };
+    let bench = ["bench", "optimum", "--no-rss", "--repeat", "1"];
+    no_work(&[&bench[..], &["--sizes", "0"]].concat(), "--sizes 0");
+    no_work(
+        &[&bench[..], &["--sizes", "1000", "--lattice-sizes", "2"]].concat(),
+        "--lattice-sizes 2: sizes must be between 100 triangles",
+    );
+    no_work(
+        &["bench", "search", "--max-grid", "1"],
+        "--max-grid 1: the grid rows start at 10000 triangles",
+    );
+    let ico = ["generate", "icosphere", "-o", "s.msh", "--triangles"];
+    no_work(&[&ico[..], &["0"]].concat(), "at least 20 triangles");
+    assert!(!tmp.path().join("s.msh").exists());
+    // A target that is not a level's count: the closest level, and the line says so.
+    let o = run_in(tmp.path(), &[&ico[..], &["30"]].concat());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        out.contains("20 triangles")
+            && out.contains("20 * 4^0 is the closest count to --triangles 30"),
+        "{out}"
+    );
+}
+
+/// An output directory that takes no new file is refused before the search (it ran, then
+/// failed writing), for every command with `-o`.
+#[cfg(target_os = "linux")]
+#[test]
+fn unwritable_output_directory_is_refused_before_the_work() {
+    let tmp = tempfile::tempdir().unwrap();
+    // /proc takes no new file, even for root.
+    for args in [
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "greedy",
+            "-o",
+            "/proc/q.msh",
+        ][..],
+        &["optimum", "sphere", "-o", "/proc/q.vtu"],
+        &[
+            "generate",
+            "grid",
+            "--triangles",
+            "100",
+            "-o",
+            "/proc/q.msh",
+        ],
+    ] {
+        let o = run_in(tmp.path(), args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(o.stdout.is_empty(), "{args:?}: no work done");
+        assert!(
+            err.contains("directory /proc does not take a new file"),
+            "{args:?}: {err}"
+        );
+    }
+}
+
+/// `sweep --out` under a regular file names the user's path and the file in the way (it
+/// named the internal `f/sub/optimum-cache`), before any work; so does `merge --out`.
+#[test]
+fn results_directory_under_a_file_names_the_users_path() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("f"), "").unwrap();
+    let err = fails_with(
+        tmp.path(),
+        &sweep_args("f/sub/deeper"),
+        4,
+        "--out f/sub/deeper: f is a regular file, not a directory",
+    );
+    assert!(!err.contains("optimum-cache"), "{err}");
+    fails_with(
+        tmp.path(),
+        &["merge", "a", "b", "--out", "f/m"],
+        4,
+        "--out f/m: f is a regular file",
+    );
+}
+
+/// `-q` means errors and warnings only: a sweep that succeeds with an explicit backend prints
+/// nothing (it printed the "runs done" and report lines).
+#[test]
+fn quiet_sweep_prints_nothing_on_success() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut args = sweep_args("d");
+    args.retain(|a| *a != "--no-report");
+    let o = run_in(tmp.path(), &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "");
+    assert!(o.stdout.is_empty());
+    assert!(tmp.path().join("d/report.md").is_file());
+}
+
+/// `optimum -o` says what it wrote, as `recombine` does.
+#[test]
+fn optimum_output_prints_a_wrote_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run_in(tmp.path(), &["optimum", "sphere", "-o", "o.msh"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(tmp.path().join("o.msh").is_file());
+    assert!(out.lines().any(|l| l == "wrote           o.msh"), "{out}");
+}
+
+/// `info`'s time line lists the steps, each with its own time, and the wall total
+/// separately, never less than their sum (it read "parse X ms (read, topology, candidates)"
+/// as though the parts made up the parse time, which they exceeded).
+#[test]
+fn info_time_line_parts_fit_in_the_total() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run_in(tmp.path(), &["info", "borouchaki"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("time:"))
+        .expect("a time line");
+    let num = |after: &str| -> f64 {
+        let rest = &line[line
+            .find(after)
+            .unwrap_or_else(|| panic!("{after}: {line}"))
+            + after.len()..];
+        rest.trim_start()
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let parts: f64 = ["read", "parse", "topology", "candidates"]
+        .iter()
+        .map(|s| num(s))
+        .sum();
+    let total = num(";");
+    assert!(line.ends_with("ms in all (wall)"), "{line}");
+    assert!(parts <= total + 0.02, "{line}");
+    let o = run_in(tmp.path(), &["info", "borouchaki", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let t = &v["time_ms"];
+    let sum: f64 = ["read", "parse", "topology", "candidates"]
+        .iter()
+        .map(|k| t[k].as_f64().unwrap())
+        .sum();
+    assert!(sum <= t["total"].as_f64().unwrap(), "{t}");
 }

@@ -962,3 +962,27 @@ fn typical_runs_are_rerun_reproduced_and_drawn() {
             .is_file()
     );
 }
+
+/// `--zoom` takes negative coordinates without `=` (clap read `-0.5,...` as a flag).
+#[test]
+fn zoom_takes_negative_values_without_equals() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("res");
+    std::fs::create_dir(&dir).unwrap();
+    real_sphere_dir(&dir, 0.0);
+    let args = [
+        "report",
+        "res",
+        "--picture",
+        "greedy",
+        "--zoom",
+        "-0.5,-0.5,0.5,0.5",
+    ];
+    let out = run_in(tmp.path(), &args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("figures/sphere-greedy-zoom.svg").is_file());
+}
