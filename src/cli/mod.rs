@@ -1,6 +1,7 @@
 //! Subcommands, one module each: `Args` (clap derive) and `run(args)`.
 
 mod bench;
+mod completions;
 mod errors;
 mod generate;
 mod info;
@@ -14,7 +15,7 @@ mod report;
 mod sweep;
 mod sweep_progress;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
 pub use errors::{describe, exit_code};
@@ -46,6 +47,8 @@ enum Command {
     Replay(replay::Args),
     /// Print benchmark figures.
     Bench(bench::Args),
+    /// Print a shell completion script (bash, zsh, fish) on stdout.
+    Completions(completions::Args),
 }
 
 /// Parses the command line and runs the subcommand.
@@ -61,6 +64,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Report(args) => report::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Completions(args) => completions::run(args, Cli::command()),
     }
 }
 

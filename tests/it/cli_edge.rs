@@ -354,3 +354,47 @@ fn info_time_line_parts_fit_in_the_total() {
         .sum();
     assert!(sum <= t["total"].as_f64().unwrap(), "{t}");
 }
+
+/// `completions SHELL` prints a script the shell takes: bash completes the subcommands and a
+/// subcommand's flags through it; zsh's and fish's name the command and its subcommands.
+#[test]
+fn completions_complete_subcommands_and_flags() {
+    let tmp = tempfile::tempdir().unwrap();
+    let script = |shell: &str| {
+        let o = run_in(tmp.path(), &["completions", shell]);
+        assert!(o.status.success(), "{shell}: {}", stderr(&o));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let bash = script("bash");
+    std::fs::write(tmp.path().join("q.bash"), &bash).unwrap();
+    // What bash offers after `quadrecomb sw` and `quadrecomb sweep --ba`.
+    let complete = |words: &str| {
+        let line = format!(
+            "source ./q.bash; COMP_WORDS=({words}); COMP_CWORD=$((${{#COMP_WORDS[@]}} - 1)); \
+             COMP_LINE=\"{words}\"; COMP_POINT=${{#COMP_LINE}}; \
+             $(complete -p quadrecomb | sed 's/.*-F \\([^ ]*\\).*/\\1/') quadrecomb \
+             \"${{COMP_WORDS[COMP_CWORD]}}\" \"${{COMP_WORDS[COMP_CWORD-1]}}\"; \
+             printf '%s\\n' \"${{COMPREPLY[@]}}\""
+        );
+        let o = std::process::Command::new("bash")
+            .args(["-c", &line])
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    assert_eq!(complete("quadrecomb sw").trim(), "sweep");
+    let flags = complete("quadrecomb sweep --ba");
+    assert!(flags.lines().any(|l| l == "--backend"), "{flags}");
+    assert!(flags.lines().any(|l| l == "--baseline-runs"), "{flags}");
+    let zsh = script("zsh");
+    assert!(zsh.starts_with("#compdef quadrecomb"), "{zsh}");
+    let fish = script("fish");
+    assert!(fish.contains("complete -c quadrecomb"), "{fish}");
+    assert!(fish.contains("-a \"sweep\""), "{fish}");
+    for s in [&zsh, &fish] {
+        assert!(s.contains("completions") && s.contains("replay"));
+    }
+    fails_with(tmp.path(), &["completions", "tcsh"], 2, "tcsh");
+}
