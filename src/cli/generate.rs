@@ -12,6 +12,10 @@ use std::time::Instant;
 pub struct Args {
     #[command(subcommand)]
     shape: Shape,
+    /// Print one JSON object on stdout (file, counts, what was made, times) instead of the
+    /// "wrote" line.
+    #[arg(long, global = true)]
+    json: bool,
 }
 
 #[derive(Debug, clap::Subcommand)]
@@ -86,6 +90,7 @@ struct IcosphereArgs {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let start = Instant::now();
+    let json = args.json;
     let (mesh, what, output) = match args.shape {
         Shape::Grid(a) => {
             let spec = GridSpec {
@@ -153,6 +158,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let start = Instant::now();
     super::write_mesh_output(&output, &mesh, &Recombined::unrecombined(&mesh))?;
     let written = start.elapsed().as_secs_f64();
+    if json {
+        let v = serde_json::json!({
+            "output": output,
+            "triangles": mesh.num_triangles(),
+            "vertices": mesh.vertices.len(),
+            "shape": what,
+            "generate_s": generated,
+            "write_s": written,
+        });
+        println!("{v}");
+        return Ok(ExitCode::SUCCESS);
+    }
     println!(
         "wrote {}: {} triangles, {} vertices ({what}); generated in {generated:.3} s, written in {written:.3} s",
         output.display(),

@@ -398,3 +398,107 @@ fn completions_complete_subcommands_and_flags() {
     }
     fails_with(tmp.path(), &["completions", "tcsh"], 2, "tcsh");
 }
+
+/// Parses `o`'s stdout as exactly one JSON object (a single line), after a success.
+fn one_object(o: &std::process::Output) -> serde_json::Value {
+    assert!(o.status.success(), "{}", stderr(o));
+    let out = String::from_utf8(o.stdout.clone()).unwrap();
+    assert_eq!(out.lines().count(), 1, "one line on stdout: {out}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(v.is_object(), "{v}");
+    v
+}
+
+/// `--json` on `sweep`, `merge`, `report` and `generate`: one object on stdout saying what
+/// was written (paths that exist), counts and time; progress and notes stay on stderr, so
+/// `sweep ... --json | jq .` works (`sweep` wrote nothing to stdout).
+#[test]
+fn json_results_on_stdout_notes_on_stderr() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exists = |v: &serde_json::Value| {
+        let p = tmp.path().join(v.as_str().unwrap_or_else(|| panic!("{v}")));
+        assert!(p.is_file(), "{}", p.display());
+    };
+    let g = one_object(&run_in(
+        tmp.path(),
+        &[
+            "generate",
+            "grid",
+            "--triangles",
+            "200",
+            "-o",
+            "g.msh",
+            "--json",
+        ],
+    ));
+    assert_eq!(g["output"], "g.msh");
+    exists(&g["output"]);
+    assert!(g["triangles"].as_u64().unwrap() > 100 && g["vertices"].as_u64().is_some());
+    assert!(g["generate_s"].is_f64() && g["write_s"].is_f64(), "{g}");
+
+    let mut args = sweep_args("d");
+    args.retain(|a| *a != "-q" && *a != "--no-report");
+    args.extend(["--plain", "--json"]);
+    let o = run_in(tmp.path(), &args);
+    assert!(stderr(&o).contains("sweep: 1/1 runs"), "{}", stderr(&o));
+    let s = one_object(&o);
+    assert_eq!(
+        (s["out"].as_str(), s["runs"].as_u64()),
+        (Some("d"), Some(1))
+    );
+    assert_eq!(
+        (s["new"].as_u64(), s["cancelled"].as_bool()),
+        (Some(1), Some(false))
+    );
+    for f in ["runs", "manifest", "summary_json", "summary_csv"] {
+        exists(&s["files"][f]);
+    }
+    exists(&s["report"]["markdown"]);
+    exists(&s["report"]["html"]);
+    s["report"]["figures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .for_each(exists);
+    assert!(s["time_s"].is_f64());
+    // The same through jq, as a user pipes it (where jq is installed).
+    let jq = std::process::Command::new("jq").arg("--version").output();
+    if jq.is_ok_and(|o| o.status.success()) {
+        let pipe = format!(
+            "{} report d --no-pictures --json | jq -r .markdown",
+            crate::util::bin().display()
+        );
+        let o = std::process::Command::new("sh")
+            .args(["-c", &pipe])
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "d/report.md");
+    } else {
+        eprintln!("skipping the jq pipe: no jq here");
+    }
+    let r = one_object(&run_in(
+        tmp.path(),
+        &["report", "d", "--no-pictures", "--json"],
+    ));
+    assert_eq!(r["dir"], "d");
+    exists(&r["html"]);
+
+    let mut shard = sweep_args("p1");
+    shard.extend(["--shard", "1/1"]);
+    assert!(run_in(tmp.path(), &shard).status.success());
+    let o = run_in(tmp.path(), &["merge", "p1", "--out", "m", "--json"]);
+    assert!(
+        stderr(&o).contains("merge: 1 runs from 1 directories"),
+        "{}",
+        stderr(&o)
+    );
+    let m = one_object(&o);
+    assert_eq!(
+        (m["out"].as_str(), m["runs"].as_u64()),
+        (Some("m"), Some(1))
+    );
+    assert_eq!(m["parts"], serde_json::json!(["p1"]));
+    exists(&m["files"]["runs"]);
+    exists(&m["report"]["markdown"]);
+}
