@@ -986,3 +986,54 @@ fn zoom_takes_negative_values_without_equals() {
     );
     assert!(dir.join("figures/sphere-greedy-zoom.svg").is_file());
 }
+
+/// `--picture optimum` draws the optimum's matching, computed again (it was accepted and drew
+/// nothing); a re-run of `report` removes the figures its previous run wrote and no longer
+/// draws, and only those (a user's file in figures/ stays); the optimum's "nodes per tree" is
+/// "–", not 0: it builds no tree.
+#[test]
+fn optimum_pictured_stale_figures_removed_no_tree_is_a_dash() {
+    let tmp = tempfile::tempdir().unwrap();
+    let err = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).into_owned();
+    let sweep = [
+        "sweep",
+        "--mesh",
+        "sphere",
+        "--algo",
+        "greedy",
+        "optimum",
+        "--backend",
+        "cpu",
+        "--no-report",
+        "-q",
+        "--out",
+        "d",
+    ];
+    let o = run_in(tmp.path(), &sweep);
+    assert!(o.status.success(), "{}", err(&o));
+    let d = tmp.path().join("d");
+    let o = run_in(tmp.path(), &["report", "d", "--picture", "greedy"]);
+    assert!(o.status.success(), "{}", err(&o));
+    assert!(d.join("figures/sphere-greedy-mesh.svg").is_file());
+    std::fs::write(d.join("figures/mine.svg"), "<svg/>").unwrap();
+
+    let o = run_in(tmp.path(), &["report", "d", "--picture", "optimum"]);
+    assert!(o.status.success(), "{}", err(&o));
+    let svg = std::fs::read_to_string(d.join("figures/sphere-optimum-mesh.svg")).unwrap();
+    parse_and_render(&svg);
+    assert!(polygons(&svg) > 400, "the optimum's quads are drawn");
+    let md = std::fs::read_to_string(d.join("report.md")).unwrap();
+    assert!(
+        md.contains("optimum (maximum-weight matching): 1052 quads, 0 triangles left")
+            && md.contains("Matching computed again with eta from")
+            && md.contains("reproduces the recorded quads and quality exactly"),
+        "{md}"
+    );
+    // The greedy picture of the previous run is gone; the user's file is not.
+    assert!(!d.join("figures/sphere-greedy-mesh.svg").exists());
+    assert!(d.join("figures/mine.svg").is_file());
+    // Table 1: the optimum's nodes per tree (7th column) is a dash.
+    let row = md.lines().find(|l| l.starts_with("| optimum |")).unwrap();
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    assert_eq!(cells[7], "–", "{row}");
+}
