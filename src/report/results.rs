@@ -10,7 +10,10 @@ use std::path::{Path, PathBuf};
 /// Tree nodes expanded per look-ahead tree of a run; `None` when it built none (the
 /// optimum, greedy-nocrit, a run whose record predates the count).
 pub fn nodes_per_tree(run: &Run) -> Option<f64> {
-    (run.trees > 0).then(|| run.nodes_expanded as f64 / run.trees as f64)
+    match (run.nodes_expanded, run.trees) {
+        (Some(n), Some(t)) if t > 0 => Some(n as f64 / t as f64),
+        _ => None,
+    }
 }
 
 /// A configuration: what a group of runs shares.

@@ -502,3 +502,54 @@ fn json_results_on_stdout_notes_on_stderr() {
     exists(&m["files"]["runs"]);
     exists(&m["report"]["markdown"]);
 }
+
+/// Records and `--json` agree on "not applicable": greedy-nocrit and the optimum build no
+/// tree, so their `nodes_expanded` and `trees` are null in the sweep's records, in
+/// `recombine --json` and in `optimum --json` (greedy-nocrit counted its decisions as trees,
+/// the optimum's record had 0 where `optimum --json` had null); greedy's one-node trees and
+/// selective's trees are counted. Committed records with the old numbers still read.
+#[test]
+fn no_tree_is_null_in_records_and_json() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut args = sweep_args("d");
+    // Every algorithm but uniform (greedy is there already).
+    args.extend(["--algo", "greedy-nocrit", "selective", "optimum"]);
+    args.extend(["--horizons", "2", "--runs", "1"]);
+    let o = run_in(tmp.path(), &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(tmp.path().join("d/runs.jsonl")).unwrap();
+    let records: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), 4);
+    for r in &records {
+        let none = ["greedy-nocrit", "optimum"].contains(&r["algo"].as_str().unwrap());
+        for f in ["nodes_expanded", "trees"] {
+            assert_eq!(r[f].is_null(), none, "{f}: {r}");
+            assert!(none || r[f].as_u64().unwrap() > 0, "{f}: {r}");
+        }
+    }
+    let json = |args: &[&str]| -> serde_json::Value {
+        let o = run_in(tmp.path(), args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let nocrit = json(&["recombine", "sphere", "--algo", "greedy-nocrit", "--json"]);
+    let optimum = json(&["optimum", "sphere", "--json"]);
+    let greedy = json(&["recombine", "sphere", "--algo", "greedy", "--json"]);
+    for f in ["nodes_expanded", "trees"] {
+        assert!(nocrit[f].is_null() && optimum[f].is_null(), "{f}");
+        assert_eq!(
+            greedy[f], greedy["decisions"],
+            "{f}: greedy's one-node trees"
+        );
+    }
+    // The committed records (old numbers) still read, as they are.
+    let committed = crate::util::repo_path("results/sphere/runs.jsonl");
+    let old = quadrecomb::experiment::store::read(&committed)
+        .unwrap()
+        .records;
+    let opt = old.iter().find(|r| r.algo == "optimum").unwrap();
+    assert_eq!((opt.nodes_expanded, opt.trees), (Some(0), Some(0)));
+}
