@@ -7,7 +7,7 @@
 //! | 1 | any other failure (a file the system cannot read or write, no GPU, a bug) |
 //! | 2 | usage error: an unknown flag or a value it refuses (clap), a value out of range |
 //! | 3 | bad input: a mesh file unreadable or invalid, a results directory whose files are corrupt or do not form one sweep |
-//! | 4 | the results directory cannot be used: it holds other runs or another configuration, another sweep is writing it, or it is not a directory |
+//! | 4 | the results directory cannot be used: it holds other runs or another configuration, another sweep is writing it, or it is not a directory or lies under a file |
 //! | 5 | out of memory ([`super::oom`]) |
 //! | 130 | interrupted (Ctrl-C) |
 
@@ -38,6 +38,42 @@ pub fn exit_code(err: &anyhow::Error) -> u8 {
     err.chain().find_map(code).unwrap_or(EXIT_FAILURE)
 }
 
+/// A results directory the command cannot use as given, worded by the command with the
+/// user's own path (exit code [`EXIT_RESULTS_DIR`]).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UnusableResultsDir(pub String);
+
+/// Refuses, before any work, a results directory `--out DIR` that cannot be one: `dir` is a
+/// file, or lies under a file (`--out f/sub` named the internal `f/sub/optimum-cache` when
+/// the sweep failed to create it). Names the user's path and the file in the way.
+pub fn check_results_dir(dir: &std::path::Path) -> anyhow::Result<()> {
+    let existing = dir
+        .ancestors()
+        .filter(|a| !a.as_os_str().is_empty())
+        .find_map(|a| std::fs::metadata(a).ok().map(|m| (a, m)));
+    match existing {
+        Some((a, meta)) if !meta.is_dir() => {
+            let kind = quadrecomb::internals::mesh::file_kind(&meta).to_string();
+            if a == dir {
+                return Err(ExperimentError::NotADirectory {
+                    dir: dir.to_path_buf(),
+                    kind,
+                }
+                .into());
+            }
+            Err(UnusableResultsDir(format!(
+                "--out {}: {} is {kind}, not a directory, so no results directory can be made \
+                 under it; choose another --out",
+                dir.display(),
+                a.display()
+            ))
+            .into())
+        }
+        _ => Ok(()),
+    }
+}
+
 /// The code one cause decides, if it decides one.
 fn code(e: &(dyn Error + 'static)) -> Option<u8> {
     if e.is::<BadInput>() {
@@ -45,6 +81,9 @@ fn code(e: &(dyn Error + 'static)) -> Option<u8> {
     }
     if e.is::<super::InputError>() {
         return Some(EXIT_BAD_INPUT);
+    }
+    if e.is::<UnusableResultsDir>() {
+        return Some(EXIT_RESULTS_DIR);
     }
     if e.is::<quadrecomb::internals::mesh::ReadError>()
         || e.is::<quadrecomb::internals::mesh::MeshError>()

@@ -12,6 +12,10 @@ use std::time::Instant;
 pub struct Args {
     #[command(subcommand)]
     shape: Shape,
+    /// Print one JSON object on stdout (file, counts, what was made, times) instead of the
+    /// "wrote" line.
+    #[arg(long, global = true)]
+    json: bool,
 }
 
 #[derive(Debug, clap::Subcommand)]
@@ -75,7 +79,8 @@ struct IcosphereArgs {
     /// Subdivision level s (0 to 10): 20 * 4^s triangles.
     #[arg(long)]
     subdivisions: Option<u32>,
-    /// Target number of triangles: the level whose count is closest.
+    /// Target number of triangles (at least 1): the level whose count (20 * 4^s) is closest;
+    /// the "wrote" line says so when it differs.
     #[arg(long)]
     triangles: Option<usize>,
     /// Output file (.msh, written as MSH 4.1 ASCII).
@@ -85,6 +90,7 @@ struct IcosphereArgs {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let start = Instant::now();
+    let json = args.json;
     let (mesh, what, output) = match args.shape {
         Shape::Grid(a) => {
             let spec = GridSpec {
@@ -105,6 +111,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Shape::Icosphere(a) => {
             let s = match (a.subdivisions, a.triangles) {
                 (Some(s), _) => s,
+                (None, Some(0)) => {
+                    return Err(BadInput(
+                        "--triangles 0: an icosphere has at least 20 triangles (0 \
+                         subdivisions); give a target of 1 or more, or --subdivisions"
+                            .into(),
+                    )
+                    .into());
+                }
                 (None, Some(n)) => {
                     let largest = 20usize << (2 * MAX_SUBDIVISIONS);
                     if n > 2 * largest {
@@ -125,11 +139,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .into());
             }
             check_output(&a.output)?;
-            (
-                generate::icosphere(s),
-                format!("icosphere, {s} subdivisions"),
-                a.output,
-            )
+            let made = 20usize << (2 * s);
+            // --triangles picks the closest level: say so when the count is not the target.
+            let what = match a.triangles {
+                Some(n) if a.subdivisions.is_none() && n != made => format!(
+                    "icosphere, {s} subdivisions: 20 * 4^{s} is the closest count to \
+                     --triangles {n}"
+                ),
+                _ => format!("icosphere, {s} subdivisions"),
+            };
+            (generate::icosphere(s), what, a.output)
         }
         Shape::Strip(a) => corridor(Corridor::Strip, a)?,
         Shape::Spiral(a) => corridor(Corridor::Spiral, a)?,
@@ -139,6 +158,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let start = Instant::now();
     super::write_mesh_output(&output, &mesh, &Recombined::unrecombined(&mesh))?;
     let written = start.elapsed().as_secs_f64();
+    if json {
+        let v = serde_json::json!({
+            "output": output,
+            "triangles": mesh.num_triangles(),
+            "vertices": mesh.vertices.len(),
+            "shape": what,
+            "generate_s": generated,
+            "write_s": written,
+        });
+        println!("{v}");
+        return Ok(ExitCode::SUCCESS);
+    }
     println!(
         "wrote {}: {} triangles, {} vertices ({what}); generated in {generated:.3} s, written in {written:.3} s",
         output.display(),

@@ -17,9 +17,15 @@ pub struct Args {
     /// Do not write the report of the merged results.
     #[arg(long)]
     no_report: bool,
+    /// Print one JSON object on stdout (runs, parts, files written, time); notes stay on
+    /// stderr.
+    #[arg(long)]
+    json: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let start = std::time::Instant::now();
+    super::errors::check_results_dir(&args.out)?;
     let merged = merge(&args.dirs, &args.out)?;
     eprintln!(
         "merge: {} runs from {} directories into {}",
@@ -27,6 +33,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         merged.parts,
         args.out.display()
     );
+    let mut report = serde_json::Value::Null;
     if !args.no_report {
         let out = &args.out;
         let paths = quadrecomb::internals::report::write(
@@ -42,6 +49,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             )
         })?;
         eprintln!("merge: report in {}", paths.markdown.display());
+        report = super::report::paths_json(&paths);
+    }
+    if args.json {
+        let v = serde_json::json!({
+            "out": args.out,
+            "parts": args.dirs,
+            "runs": merged.records,
+            "files": super::sweep::result_files(&args.out),
+            "report": report,
+            "time_s": start.elapsed().as_secs_f64(),
+        });
+        println!("{v}");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -1,6 +1,7 @@
 //! Subcommands, one module each: `Args` (clap derive) and `run(args)`.
 
 mod bench;
+mod completions;
 mod errors;
 mod generate;
 mod info;
@@ -14,7 +15,7 @@ mod report;
 mod sweep;
 mod sweep_progress;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
 pub use errors::{describe, exit_code};
@@ -46,6 +47,8 @@ enum Command {
     Replay(replay::Args),
     /// Print benchmark figures.
     Bench(bench::Args),
+    /// Print a shell completion script (bash, zsh, fish) on stdout.
+    Completions(completions::Args),
 }
 
 /// Parses the command line and runs the subcommand.
@@ -61,6 +64,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Report(args) => report::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Completions(args) => completions::run(args, Cli::command()),
     }
 }
 
@@ -147,7 +151,8 @@ pub fn check_mesh_output(path: Option<&std::path::Path>) -> Result<(), BadInput>
 }
 
 /// The part of [`check_mesh_output`] that does not look at the extension: `path` names a
-/// file (not a directory, no trailing slash) whose directory exists.
+/// file (not a directory, no trailing slash) in a directory that exists and takes a new file
+/// (tried by creating and removing a temporary one, as the atomic writer will).
 pub fn check_output_place(p: &std::path::Path) -> Result<(), BadInput> {
     let bad = |why: String| Err(BadInput(format!("output {}: {why}", p.display())));
     if p.is_dir() || p.as_os_str().to_string_lossy().ends_with('/') {
@@ -157,7 +162,19 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), BadInput> {
     match dir {
         Some(d) if d.exists() && !d.is_dir() => bad(format!("{} is not a directory", d.display())),
         Some(d) if !d.exists() => bad(format!("directory {} does not exist", d.display())),
-        _ => Ok(()),
+        _ => {
+            let d = dir.unwrap_or(std::path::Path::new("."));
+            match tempfile::Builder::new()
+                .prefix(".quadrecomb-")
+                .tempfile_in(d)
+            {
+                Ok(_) => Ok(()),
+                Err(e) => bad(format!(
+                    "directory {} does not take a new file ({e}); choose another -o",
+                    d.display()
+                )),
+            }
+        }
     }
 }
 

@@ -92,6 +92,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 r.edges_checked, r.blossoms, r.positive_blossoms
             );
         }
+        if let Some(p) = &args.output {
+            println!("wrote           {}", p.display());
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -129,6 +129,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         super::write_mesh_output(path, &mesh, &rec)?;
     }
     let horizon = horizon_of(algo);
+    // null where the policy builds no tree (greedy-nocrit), as its sweep record has it.
+    let trees = quadrecomb::internals::experiment::record::builds_trees(algo.name());
+    let (nodes_expanded, tree_count) = (
+        trees.then_some(out.nodes_expanded),
+        trees.then_some(out.trees),
+    );
     if args.json {
         let mut v = serde_json::json!({
             "mesh": args.mesh,
@@ -141,8 +147,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "recombined_pct": recombined_pct,
             "quality": out.quality,
             "time_s": out.time_s,
-            "nodes_expanded": out.nodes_expanded,
-            "trees": out.trees,
+            "nodes_expanded": nodes_expanded,
+            "trees": tree_count,
             "decisions": out.decisions,
             "backend": backend,
         });
@@ -171,10 +177,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             _ => println!("quality         {:.4} (sum of eta)", out.quality),
         }
         super::print_element_lines(&elements, rule);
-        println!(
-            "nodes expanded  {} ({} look-ahead trees)",
-            out.nodes_expanded, out.trees
-        );
+        match (nodes_expanded, tree_count) {
+            (Some(n), Some(t)) => println!("nodes expanded  {n} ({t} look-ahead trees)"),
+            _ => println!("nodes expanded  – (no look-ahead tree: {algo} builds none)"),
+        }
         println!("time            {:.4} s", out.time_s);
         if let Some(p) = &args.output {
             println!("wrote           {}", p.display());

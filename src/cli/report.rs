@@ -12,8 +12,9 @@ pub struct Args {
     /// Another results directory to compare with, configuration by configuration.
     #[arg(long, value_name = "DIR2")]
     compare: Option<PathBuf>,
-    /// Also draw the mesh pictures zoomed into this window (picture coordinates).
-    #[arg(long, value_name = "x0,y0,x1,y1")]
+    /// Also draw the mesh pictures zoomed into this window (picture coordinates; negative
+    /// values need no `=`: `--zoom -1,-1,0,0`).
+    #[arg(long, value_name = "x0,y0,x1,y1", allow_hyphen_values = true)]
     zoom: Option<String>,
     /// Picture the typical run of this configuration, e.g. `selective:5` or `greedy`
     /// (repeatable; default: the best horizon of each look-ahead algorithm).
@@ -25,6 +26,19 @@ pub struct Args {
     /// Seed of the bootstrap confidence intervals.
     #[arg(long, default_value_t = ReportOptions::default().seed)]
     seed: u64,
+    /// Print one JSON object on stdout (the files written, the time) instead of their paths.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The files a report wrote, as the `report` member of a `--json` object (`sweep`,
+/// `merge`) or the whole of `report --json`'s.
+pub fn paths_json(paths: &report::ReportPaths) -> serde_json::Value {
+    serde_json::json!({
+        "markdown": paths.markdown,
+        "html": paths.html,
+        "figures": paths.figures,
+    })
 }
 
 /// Parses "x0,y0,x1,y1" into a window with x0 < x1 and y0 < y1.
@@ -63,6 +77,7 @@ fn parse_picture(s: &str) -> Result<(String, Option<u32>), BadInput> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let start = std::time::Instant::now();
     let zoom = args.zoom.as_deref().map(parse_zoom).transpose()?;
     let picture_configs = args
         .pictures
@@ -78,6 +93,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     // Its exit code follows the error's kind (`errors::exit_code`).
     let paths = report::write(&args.dir, &opts)?;
+    if args.json {
+        let mut v = paths_json(&paths);
+        v["dir"] = serde_json::json!(args.dir);
+        v["time_s"] = serde_json::json!(start.elapsed().as_secs_f64());
+        println!("{v}");
+        return Ok(ExitCode::SUCCESS);
+    }
     println!("{}", paths.markdown.display());
     println!("{}", paths.html.display());
     for f in &paths.figures {

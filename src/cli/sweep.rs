@@ -5,7 +5,6 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context;
-use quadrecomb::internals::experiment::ExperimentError;
 use quadrecomb::internals::experiment::config::{
     ConfigError, DEFAULT_SEED, MAX_HORIZONS, MAX_RUNS, SizeError, SweepConfig, SweepRequest,
 };
@@ -91,9 +90,32 @@ pub struct Args {
     /// Progress as plain lines even on a terminal.
     #[arg(long, conflicts_with = "quiet")]
     plain: bool,
-    /// No progress output.
+    /// Quiet: only errors and warnings on stderr (no progress, no notices, no summary).
     #[arg(long, short)]
     quiet: bool,
+    /// Print one JSON object on stdout when done (runs, files written, report, time);
+    /// progress and notes stay on stderr.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The sweep's own files that exist in `dir` (runs, manifest, summaries), by role, for a
+/// `--json` object.
+pub fn result_files(dir: &std::path::Path) -> serde_json::Value {
+    use quadrecomb::internals::experiment::{manifest, store, summary};
+    let mut files = serde_json::Map::new();
+    for (role, name) in [
+        ("runs", store::RUNS_FILE),
+        ("manifest", manifest::MANIFEST_FILE),
+        ("summary_json", summary::SUMMARY_JSON),
+        ("summary_csv", summary::SUMMARY_CSV),
+    ] {
+        let path = dir.join(name);
+        if path.is_file() {
+            files.insert(role.into(), serde_json::json!(path));
+        }
+    }
+    files.into()
 }
 
 #[derive(Debug, Clone)]
@@ -139,6 +161,7 @@ fn parse_horizons(s: &str) -> Result<Horizons, String> {
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let start = std::time::Instant::now();
     let paper = SweepRequest::default();
     let meshes = if args.meshes.is_empty() {
         paper.meshes.clone()
@@ -157,15 +180,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         };
         PathBuf::from("results").join(name)
     });
-    if let Ok(meta) = std::fs::metadata(&out)
-        && !meta.is_dir()
-    {
-        return Err(ExperimentError::NotADirectory {
-            kind: quadrecomb::internals::mesh::file_kind(&meta).to_string(),
-            dir: out,
-        }
-        .into());
-    }
+    super::errors::check_results_dir(&out)?;
     let config = SweepConfig::new(SweepRequest {
         meshes,
         algos: if args.algos.is_empty() {
@@ -226,7 +241,25 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .shard
         .map(|s| format!(" (shard {s})"))
         .unwrap_or_default();
+    let json = |report_paths: serde_json::Value| {
+        let v = serde_json::json!({
+            "out": out,
+            "runs": report.planned,
+            "new": report.done_now,
+            "already_recorded": report.already,
+            "cancelled": report.cancelled,
+            "shard": manifest.shard.map(|s| s.to_string()),
+            "backend": manifest.backend,
+            "files": result_files(&out),
+            "report": report_paths,
+            "time_s": start.elapsed().as_secs_f64(),
+        });
+        println!("{v}");
+    };
     if report.cancelled {
+        if args.json {
+            json(serde_json::Value::Null);
+        }
         eprintln!(
             "sweep: interrupted: {} of {} runs recorded in {}{shard}; run the same command with --resume to finish",
             report.already + report.done_now,
@@ -235,14 +268,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
         return Ok(ExitCode::from(EXIT_INTERRUPTED));
     }
-    eprintln!(
-        "sweep: {} runs done ({} new, {} already recorded) into {}{shard}; backend {}",
-        report.planned,
-        report.done_now,
-        report.already,
-        out.display(),
-        manifest.backend
-    );
+    if !args.quiet {
+        eprintln!(
+            "sweep: {} runs done ({} new, {} already recorded) into {}{shard}; backend {}",
+            report.planned,
+            report.done_now,
+            report.already,
+            out.display(),
+            manifest.backend
+        );
+    }
+    let mut report_paths = serde_json::Value::Null;
     if !args.no_report && manifest.shard.is_none() {
         let paths = quadrecomb::internals::report::write(
             &out,
@@ -256,7 +292,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 out.display()
             )
         })?;
-        eprintln!("sweep: report in {}", paths.markdown.display());
+        if !args.quiet {
+            eprintln!("sweep: report in {}", paths.markdown.display());
+        }
+        report_paths = super::report::paths_json(&paths);
+    }
+    if args.json {
+        json(report_paths);
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use quadrecomb::internals::experiment::events::Event;
+use quadrecomb::internals::gpu::BackendNote;
 
 /// How progress is shown.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -19,12 +20,12 @@ pub enum ProgressMode {
     Auto,
     /// Plain lines every [`PLAIN_PERIOD`].
     Plain,
-    /// Nothing.
+    /// No progress and no notices: only warnings (and errors).
     Quiet,
 }
 
-/// Shows what a sweep reports: the backend chosen (always), the resume notice and the
-/// progress (as `mode` says).
+/// Shows what a sweep reports: the backend chosen (under -q only when it is a warning: a
+/// fallback or a failed adapter), the resume notice and the progress (as `mode` says).
 #[derive(Debug)]
 pub struct SweepDisplay {
     mode: ProgressMode,
@@ -43,7 +44,19 @@ impl SweepDisplay {
     /// Shows one event.
     pub fn event(&mut self, event: Event<'_>) {
         match event {
-            Event::Backend(note) => eprintln!("quality backend: {note}"),
+            // Under -q only warnings: a fallback or a failed adapter, not the GPU picked.
+            Event::Backend(note) => {
+                let info = matches!(
+                    note,
+                    BackendNote::Picked {
+                        software: false,
+                        ..
+                    }
+                );
+                if self.mode != ProgressMode::Quiet || !info {
+                    eprintln!("quality backend: {note}");
+                }
+            }
             Event::Resuming {
                 recorded,
                 planned,

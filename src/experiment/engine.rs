@@ -87,8 +87,8 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
             .filter(|&o| o > 0.0)
             .map(|o| 100.0 * out.quality / o),
         time_s: out.time_s,
-        nodes_expanded: out.nodes_expanded,
-        trees: out.trees,
+        nodes_expanded: super::record::builds_trees(&job.algo).then_some(out.nodes_expanded),
+        trees: super::record::builds_trees(&job.algo).then_some(out.trees),
         decisions: out.decisions,
         branching_factor,
         worst_eta: out.elements.worst,

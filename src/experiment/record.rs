@@ -38,13 +38,17 @@ pub struct RunRecord {
     pub quality_pct: Option<f64>,
     /// Seconds spent in the search (or the matching, for "optimum"), excluding loading and eta.
     pub time_s: f64,
-    /// Tree nodes expanded by the search (0 for "optimum").
-    pub nodes_expanded: u64,
+    /// Tree nodes expanded by the search; `None` (null) for the algorithms that build no
+    /// tree, "greedy-nocrit" and "optimum" (see [`builds_trees`]). Older records have 0 for
+    /// the optimum and the decisions for greedy-nocrit, and are read as they are.
+    pub nodes_expanded: Option<u64>,
     /// Look-ahead trees the search built: one per decision, except the selective decisions
-    /// whose root triangle had a single allowed action (no tree can change those); 0 for
-    /// "optimum" and in records written before this field existed.
+    /// whose root triangle had a single allowed action (no tree can change those); greedy's
+    /// are one-node trees (a uniform tree of horizon 1), one per decision. `None` (null) for
+    /// "greedy-nocrit" and "optimum", which build none, and in records written before this
+    /// field existed.
     #[serde(default)]
-    pub trees: u64,
+    pub trees: Option<u64>,
     /// Actions applied (decisions taken) by the search; quads for "optimum".
     pub decisions: u64,
     /// Effective branching factor of the look-ahead tree, for `uniform` and `selective` with
@@ -77,6 +81,13 @@ pub struct RunRecord {
     pub backend: String,
     /// Version of quadrecomb that made the record.
     pub version: String,
+}
+
+/// Whether `algo` (a record's name) searches with look-ahead trees, so that its
+/// `nodes_expanded` and `trees` apply: not "greedy-nocrit" (no criterion, no tree) nor
+/// "optimum" (a matching), whose records hold null there, as `optimum --json` does.
+pub fn builds_trees(algo: &str) -> bool {
+    !matches!(algo, "greedy-nocrit" | "optimum")
 }
 
 /// What a field that records the rule reads when absent: the rule of every record and

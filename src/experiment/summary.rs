@@ -121,7 +121,7 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
                 quality_pct: BoxStats::of(&col(&|r| r.quality_pct)),
                 recombined_pct: BoxStats::of(&col(&|r| Some(r.recombined_pct))),
                 time_s: BoxStats::of(&col(&|r| Some(r.time_s))),
-                nodes_expanded: BoxStats::of(&col(&|r| Some(r.nodes_expanded as f64))),
+                nodes_expanded: BoxStats::of(&col(&|r| r.nodes_expanded.map(|n| n as f64))),
                 mean_branching_factor: (!bf.is_empty()).then(|| crate::stats::describe::mean(&bf)),
                 branching_factor: BoxStats::of(&bf),
                 mean_eta: BoxStats::of(&col(&|r| r.mean_eta)),

@@ -67,10 +67,15 @@ pub(super) fn mesh_section(
             fmt_opt(median_of(summary, c, |g| g.quality_pct.as_ref()), 2),
             format!("{:.2}", metric_median(summary, c, runs, Metric::Recombined)),
             fmt_sig(metric_median(summary, c, runs, Metric::Time), 3),
-            fmt_sig(
-                median(&runs.iter().map(results::nodes_per_tree).collect::<Vec<_>>()),
-                3,
-            ),
+            {
+                // "–" where no run built a tree (it printed 0).
+                let per_tree: Vec<f64> = runs.iter().filter_map(results::nodes_per_tree).collect();
+                if per_tree.is_empty() {
+                    "–".to_string()
+                } else {
+                    fmt_sig(median(&per_tree), 3)
+                }
+            },
             fmt_opt(median_of(summary, c, |g| g.branching_factor.as_ref()), 3),
         ]
     });
@@ -94,7 +99,7 @@ pub(super) fn mesh_section(
          a percentage of the optimum; recombined is the percentage of triangles merged into \
          quads; time is the search's wall time; nodes per tree is tree nodes expanded per \
          look-ahead tree (a selective decision whose root triangle has a single allowed action \
-         builds none); the branching factor is the runner's effective branching factor, the b \
+         builds none; – where the algorithm builds no tree); the branching factor is the runner's effective branching factor, the b \
          with 1 + b + ... + b^(h-1) = nodes per tree (none at h = 1). Both measure the search \
          as run: the selective tree cuts, by exact branch and bound, the subtrees that cannot \
          hold the best leaf, so it expands fewer nodes than the tree it explores (whose \

@@ -79,9 +79,6 @@ pub(super) fn pictures(
     }
     doc.heading(3, "Typical runs");
     for (c, runs) in chosen {
-        if c.algo == "optimum" {
-            continue;
-        }
         let Some(run) = typical::median_run(runs) else {
             continue;
         };

@@ -7,12 +7,12 @@ use crate::experiment::{manifest, store};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// Tree nodes expanded per look-ahead tree of a run (0 when it built none).
-pub fn nodes_per_tree(run: &Run) -> f64 {
-    if run.trees == 0 {
-        0.0
-    } else {
-        run.nodes_expanded as f64 / run.trees as f64
+/// Tree nodes expanded per look-ahead tree of a run; `None` when it built none (the
+/// optimum, greedy-nocrit, a run whose record predates the count).
+pub fn nodes_per_tree(run: &Run) -> Option<f64> {
+    match (run.nodes_expanded, run.trees) {
+        (Some(n), Some(t)) if t > 0 => Some(n as f64 / t as f64),
+        _ => None,
     }
 }
 

@@ -36,6 +36,22 @@ pub fn rerun<'a>(replayer: &'a mut Replayer<'_>, run: &Run) -> Result<Typical<'a
             out.quads, out.quality, run.quads, run.quality
         )
     };
+    // The optimum has no seed to re-run from: its matching is computed again.
+    if run.algo == "optimum" {
+        let note = format!(
+            "optimum (maximum-weight matching): {} quads, {} triangles left, quality {:.4}. \
+             Matching computed again with eta from {}; {verdict}.",
+            out.quads,
+            out.triangles_left,
+            out.quality,
+            out.eta_note(),
+        );
+        return Ok(Typical {
+            mesh: out.mesh,
+            rec: out.recombined,
+            note,
+        });
+    }
     let note = format!(
         "{label}, run {} (seed {}), the median run by quality: {} quads, {} triangles left, \
          quality {:.4}{}. Re-run from its seed with eta from {}; {verdict}.",

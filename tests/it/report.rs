@@ -246,8 +246,8 @@ fn record(
         quality: quality_pct * 9.5,
         quality_pct: Some(quality_pct),
         time_s,
-        nodes_expanded: decisions * u64::from(horizon.unwrap_or(1)) * 2,
-        trees: decisions,
+        nodes_expanded: Some(decisions * u64::from(horizon.unwrap_or(1)) * 2),
+        trees: Some(decisions),
         decisions,
         branching_factor: horizon.filter(|&h| h >= 2).map(|_| 1.5),
         worst_eta: Some(0.05),
@@ -886,8 +886,8 @@ fn real_sphere_dir(dir: &Path, tamper: f64) {
                     quality: out.quality + tamper,
                     quality_pct: None,
                     time_s: out.time_s,
-                    nodes_expanded: out.nodes_expanded,
-                    trees: out.trees,
+                    nodes_expanded: Some(out.nodes_expanded),
+                    trees: Some(out.trees),
                     decisions: out.decisions,
                     branching_factor: None,
                     worst_eta: None,
@@ -990,4 +990,79 @@ fn typical_runs_are_rerun_reproduced_and_drawn() {
             .join("figures/sphere-selective-h-2-mesh.svg")
             .is_file()
     );
+}
+
+/// `--zoom` takes negative coordinates without `=` (clap read `-0.5,...` as a flag).
+#[test]
+fn zoom_takes_negative_values_without_equals() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("res");
+    std::fs::create_dir(&dir).unwrap();
+    real_sphere_dir(&dir, 0.0);
+    let args = [
+        "report",
+        "res",
+        "--picture",
+        "greedy",
+        "--zoom",
+        "-0.5,-0.5,0.5,0.5",
+    ];
+    let out = run_in(tmp.path(), &args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("figures/sphere-greedy-zoom.svg").is_file());
+}
+
+/// `--picture optimum` draws the optimum's matching, computed again (it was accepted and drew
+/// nothing); a re-run of `report` removes the figures its previous run wrote and no longer
+/// draws, and only those (a user's file in figures/ stays); the optimum's "nodes per tree" is
+/// "–", not 0: it builds no tree.
+#[test]
+fn optimum_pictured_stale_figures_removed_no_tree_is_a_dash() {
+    let tmp = tempfile::tempdir().unwrap();
+    let err = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).into_owned();
+    let sweep = [
+        "sweep",
+        "--mesh",
+        "sphere",
+        "--algo",
+        "greedy",
+        "optimum",
+        "--backend",
+        "cpu",
+        "--no-report",
+        "-q",
+        "--out",
+        "d",
+    ];
+    let o = run_in(tmp.path(), &sweep);
+    assert!(o.status.success(), "{}", err(&o));
+    let d = tmp.path().join("d");
+    let o = run_in(tmp.path(), &["report", "d", "--picture", "greedy"]);
+    assert!(o.status.success(), "{}", err(&o));
+    assert!(d.join("figures/sphere-greedy-mesh.svg").is_file());
+    std::fs::write(d.join("figures/mine.svg"), "<svg/>").unwrap();
+
+    let o = run_in(tmp.path(), &["report", "d", "--picture", "optimum"]);
+    assert!(o.status.success(), "{}", err(&o));
+    let svg = std::fs::read_to_string(d.join("figures/sphere-optimum-mesh.svg")).unwrap();
+    parse_and_render(&svg);
+    assert!(polygons(&svg) > 400, "the optimum's quads are drawn");
+    let md = std::fs::read_to_string(d.join("report.md")).unwrap();
+    assert!(
+        md.contains("optimum (maximum-weight matching): 1052 quads, 0 triangles left")
+            && md.contains("Matching computed again with eta from")
+            && md.contains("reproduces the recorded quads and quality exactly"),
+        "{md}"
+    );
+    // The greedy picture of the previous run is gone; the user's file is not.
+    assert!(!d.join("figures/sphere-greedy-mesh.svg").exists());
+    assert!(d.join("figures/mine.svg").is_file());
+    // Table 1: the optimum's nodes per tree (7th column) is a dash.
+    let row = md.lines().find(|l| l.starts_with("| optimum |")).unwrap();
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    assert_eq!(cells[7], "–", "{row}");
 }

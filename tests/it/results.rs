@@ -113,6 +113,16 @@ fn a_reduced_sweep_reproduces_the_committed_records() {
             let old = by_key
                 .get(&rec.key())
                 .unwrap_or_else(|| panic!("{rel}: committed results lack {:?}", rec.key()));
+            // Records made before #27 item 10 hold 0 (optimum) or the decisions
+            // (greedy-nocrit) in nodes_expanded and trees, where new ones hold null: those
+            // algorithms build no tree. Until results/ is regenerated, that and only that
+            // difference is allowed, for those two algorithms only.
+            let mut rec = rec.clone();
+            let no_tree = !quadrecomb::internals::experiment::record::builds_trees(&rec.algo);
+            if no_tree && rec.nodes_expanded.is_none() && rec.trees.is_none() {
+                rec.nodes_expanded = old.nodes_expanded;
+                rec.trees = old.trees;
+            }
             assert!(
                 rec.same_result(old),
                 "{rel}: {:?} differs from the committed run:\n{rec:?}\nvs\n{old:?}",

@@ -1,7 +1,8 @@
 //! `quadrecomb bench optimum`: time of the exact optimum on the built-in meshes and on
 //! generated jittered grids of growing size, with the fitted growth exponent and peak memory.
 
-use quadrecomb::internals::mesh::generate::{self, GridSpec};
+use crate::cli::BadInput;
+use quadrecomb::internals::mesh::generate::{self, GridSpec, MAX_GRID_TRIANGLES};
 use quadrecomb::internals::mesh::{Mesh, MeshData};
 use quadrecomb::internals::quality::CandidateTable;
 use quadrecomb::internals::search::optimum;
@@ -12,10 +13,11 @@ use std::process::{Command, ExitCode};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Grid sizes in triangles (comma-separated; each is rounded to a grid of squares).
+    /// Grid sizes in triangles (comma-separated, each at least 100; each is rounded to a grid
+    /// of squares).
     #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 30_000, 100_000, 300_000, 1_000_000])]
     sizes: Vec<usize>,
-    /// Sizes of the jittered equilateral lattices (near-equilateral triangles like a frontal
+    /// Sizes of the jittered equilateral lattices, at least 100 triangles (near-equilateral triangles like a frontal
     /// Delaunay mesh: a much harder matching than the right-triangle grids).
     #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 30_000, 100_000, 200_000])]
     lattice_sizes: Vec<usize>,
@@ -33,7 +35,28 @@ pub struct Args {
     rss_child: Option<usize>,
 }
 
+/// Smallest grid or lattice size `bench optimum` times: below it a solve takes microseconds
+/// and measures the timer and the set-up, not the matching, and the growth fit means nothing.
+pub const MIN_SIZE: usize = 100;
+
+/// Refuses, before any work, sizes outside [`MIN_SIZE`, [`MAX_GRID_TRIANGLES`]] (0 panicked,
+/// 1 and 2 timed a 2-triangle mesh), naming the flag and the limit.
+fn check_sizes(flag: &str, sizes: &[usize]) -> Result<(), BadInput> {
+    match sizes
+        .iter()
+        .find(|&&n| !(MIN_SIZE..=MAX_GRID_TRIANGLES).contains(&n))
+    {
+        Some(n) => Err(BadInput(format!(
+            "{flag} {n}: sizes must be between {MIN_SIZE} triangles (below that the time is the \
+             timer's and the set-up's, not the matching's) and {MAX_GRID_TRIANGLES}"
+        ))),
+        None => Ok(()),
+    }
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    check_sizes("--sizes", &args.sizes)?;
+    check_sizes("--lattice-sizes", &args.lattice_sizes)?;
     if let Some(n) = args.rss_child {
         let mesh = grid(n, 1);
         let table = CandidateTable::build(&mesh);

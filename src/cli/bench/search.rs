@@ -15,7 +15,8 @@ pub struct Args {
     /// Seeds per randomized configuration (0, 1, ...); medians are reported.
     #[arg(long, default_value_t = 9)]
     runs: u64,
-    /// Largest generated grid for the per-triangle scaling rows (triangles).
+    /// Largest generated grid for the per-triangle scaling rows (triangles; the grids are
+    /// 10,000, 100,000, ... up to this, so at least 10,000).
     #[arg(long, default_value_t = 1_000_000)]
     max_grid: usize,
     /// Largest uniform horizon on `sphere` (h = 3 takes minutes: the remaining region turns
@@ -33,6 +34,10 @@ fn thread_cpu_s() -> Option<f64> {
     let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
     Some(ns * 1e-9)
 }
+
+/// The first (smallest) grid of the scaling rows, in triangles; then 10 times larger up to
+/// `--max-grid`.
+const FIRST_GRID: usize = 10_000;
 
 /// Rounds of the grid rows.
 const GRID_ROUNDS: usize = 3;
@@ -113,6 +118,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.runs == 0 {
         return Err(BadInput("--runs must be at least 1".into()).into());
     }
+    if args.max_grid < FIRST_GRID {
+        return Err(BadInput(format!(
+            "--max-grid {}: the grid rows start at {FIRST_GRID} triangles (then 10 times \
+             larger up to --max-grid), so at least {FIRST_GRID}",
+            args.max_grid
+        ))
+        .into());
+    }
     let rule = args.rule.rule()?;
     println!(
         "Per run (median over seeds 0..{}): wall and thread-CPU milliseconds, quality as % of \
@@ -186,7 +199,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     println!("|---:|---:|---:|---:|---:|---:|---:|");
     // As `generate grid` then `mesh::load` would give them: in spatial order.
     let mut grids = Vec::new();
-    let mut n = 10_000;
+    let mut n = FIRST_GRID;
     while n <= args.max_grid {
         let g = generate::grid(GridSpec {
             triangles: n,
