@@ -112,7 +112,7 @@ fn exit_4_results_directory() {
     );
 }
 
-/// The library's notices reach stderr through the command: the backend `auto` picked, once,
+/// The library's notices reach stderr through the command: the backend `--backend auto` picked, once,
 /// and the resume; `-q` keeps only warnings: the backend line where it is a fallback (no GPU
 /// here: lavapipe or the CPU twin), not the progress, the resume or the summary.
 #[test]
@@ -120,7 +120,7 @@ fn notices_reach_stderr_through_the_command() {
     let tmp = tempfile::tempdir().unwrap();
     let mut args = sweep_args("d");
     args.retain(|a| !["--backend", "cpu", "-q"].contains(a));
-    args.push("--plain");
+    args.extend(["--backend", "auto", "--plain"]);
     let first = run_in(tmp.path(), &args);
     let err = stderr(&first);
     assert!(first.status.success(), "{err}");

@@ -647,26 +647,24 @@ fn shards_from_other_directories_merge_and_report_finds_the_mesh() {
 #[test]
 fn deterministic_runs_once_seeds_fit_doubles_and_the_default_is_the_twin() {
     let tmp = tempfile::tempdir().unwrap();
-    let out = run_in(
-        tmp.path(),
-        &[
-            "sweep",
-            "--mesh",
-            "sphere",
-            "--algo",
-            "uniform",
-            "selective",
-            "greedy",
-            "--horizons",
-            "1..2",
-            "--runs",
-            "3",
-            "--out",
-            "d",
-            "--no-report",
-            "--plain",
-        ],
-    );
+    let args = [
+        "sweep",
+        "--mesh",
+        "sphere",
+        "--algo",
+        "uniform",
+        "selective",
+        "greedy",
+        "--horizons",
+        "1..2",
+        "--runs",
+        "3",
+        "--out",
+        "d",
+        "--no-report",
+        "--plain",
+    ];
+    let out = run_in(tmp.path(), &args);
     assert!(
         out.status.success(),
         "{}",
@@ -709,26 +707,9 @@ fn deterministic_runs_once_seeds_fit_doubles_and_the_default_is_the_twin() {
         serde_json::from_str(&std::fs::read_to_string(&manifest).unwrap()).unwrap();
     m["spec"].as_object_mut().unwrap().remove("plan_version");
     std::fs::write(&manifest, serde_json::to_string_pretty(&m).unwrap()).unwrap();
-    let again = run_in(
-        tmp.path(),
-        &[
-            "sweep",
-            "--mesh",
-            "sphere",
-            "--algo",
-            "uniform",
-            "selective",
-            "greedy",
-            "--horizons",
-            "1..2",
-            "--runs",
-            "3",
-            "--out",
-            "d",
-            "--no-report",
-            "--resume",
-        ],
-    );
+    let mut resume = args.to_vec();
+    resume.push("--resume");
+    let again = run_in(tmp.path(), &resume);
     assert_eq!(
         again.status.code(),
         Some(4),
