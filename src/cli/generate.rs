@@ -156,7 +156,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let generated = start.elapsed().as_secs_f64();
     let start = Instant::now();
-    super::write_mesh_output(&output, &mesh, &Recombined::unrecombined(&mesh))?;
+    super::write_mesh_output(&output, &mesh, &Recombined::unrecombined(&mesh), false)?;
     let written = start.elapsed().as_secs_f64();
     if json {
         let v = serde_json::json!({

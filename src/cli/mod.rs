@@ -224,16 +224,18 @@ pub fn write_mesh_output(
     path: &std::path::Path,
     mesh: &quadrecomb::internals::mesh::Mesh,
     rec: &quadrecomb::internals::mesh::Recombined,
+    vtu_ascii: bool,
 ) -> Result<(), BadInput> {
+    use quadrecomb::internals::mesh::vtu::Encoding;
     let vtu = output_kind(path) == Some(true);
+    let encoding = if vtu_ascii {
+        Encoding::Ascii
+    } else {
+        Encoding::Binary
+    };
     quadrecomb::internals::output::write_atomic(path, |mut w| {
         if vtu {
-            quadrecomb::internals::mesh::vtu::write_to(
-                &mut w,
-                mesh,
-                rec,
-                quadrecomb::internals::mesh::vtu::Encoding::Binary,
-            )
+            quadrecomb::internals::mesh::vtu::write_to(&mut w, mesh, rec, encoding)
         } else {
             quadrecomb::internals::mesh::msh::write_to(&mut w, mesh, rec)
         }

@@ -22,6 +22,10 @@ pub struct Args {
     /// Write the optimal quad mesh (quads and leftover triangles): .msh (MSH 4.1) or .vtu.
     #[arg(short = 'o', long)]
     output: Option<PathBuf>,
+    /// Write a .vtu's data arrays as text instead of zlib-compressed binary (VTK's own
+    /// default); a .msh is MSH 4.1 ASCII either way.
+    #[arg(long, requires = "output")]
+    vtu_ascii: bool,
     #[command(flatten)]
     rule: super::RuleArgs,
 }
@@ -50,6 +54,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             path,
             &mesh,
             &quality::recombined(&mesh, &table, &opt.chosen),
+            args.vtu_ascii,
         )?;
     }
     if args.json {

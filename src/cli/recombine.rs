@@ -48,6 +48,10 @@ pub struct Args {
     /// Write the recombined mesh (quads and leftover triangles): .msh (MSH 4.1) or .vtu.
     #[arg(short = 'o', long)]
     output: Option<PathBuf>,
+    /// Write a .vtu's data arrays as text instead of zlib-compressed binary (VTK's own
+    /// default); a .msh is MSH 4.1 ASCII either way.
+    #[arg(long, requires = "output")]
+    vtu_ascii: bool,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -126,7 +130,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .map(|o| 100.0 * out.quality / o.quality);
     if let Some(path) = &args.output {
         let rec = quality::recombined(&mesh, &table, &out.chosen);
-        super::write_mesh_output(path, &mesh, &rec)?;
+        super::write_mesh_output(path, &mesh, &rec, args.vtu_ascii)?;
     }
     let horizon = horizon_of(algo);
     // null where the policy builds no tree (greedy-nocrit), as its sweep record has it.

@@ -30,6 +30,10 @@ pub struct Args {
     /// .vtu. Written only when the replay reproduces the record.
     #[arg(short = 'o', long)]
     output: Option<PathBuf>,
+    /// Write a .vtu's data arrays as text instead of zlib-compressed binary (VTK's own
+    /// default); a .msh is MSH 4.1 ASCII either way.
+    #[arg(long, requires = "output")]
+    vtu_ascii: bool,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -135,7 +139,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let out = replayer.replay(record).map_err(cannot)?;
     let write = args.output.as_ref().filter(|_| out.reproduced);
     if let Some(path) = write {
-        super::write_mesh_output(path, out.mesh, &out.recombined)?;
+        super::write_mesh_output(path, out.mesh, &out.recombined, args.vtu_ascii)?;
     }
     let typical = matches!(which, Which::Typical);
     let rule = record.rule();

@@ -453,6 +453,36 @@ print(json.dumps({
     );
 }
 
+/// `-o x.vtu` writes compressed binary arrays; `--vtu-ascii` writes them as text, the same
+/// values; `--vtu-ascii` without `-o` is a usage error.
+#[test]
+fn vtu_output_is_binary_unless_asked_for_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["recombine", "sphere", "--algo", "greedy"];
+        args.extend_from_slice(extra);
+        run_in(dir.path(), &args)
+    };
+    assert!(run(&["-o", "b.vtu"]).status.success());
+    assert!(run(&["-o", "a.vtu", "--vtu-ascii"]).status.success());
+    let b = std::fs::read(dir.path().join("b.vtu")).unwrap();
+    let a = std::fs::read_to_string(dir.path().join("a.vtu")).unwrap();
+    let b_head = String::from_utf8_lossy(&b[..b.len().min(2000)]).to_string();
+    assert!(
+        b_head.contains(r#"compressor="vtkZLibDataCompressor""#),
+        "{b_head}"
+    );
+    assert!(b_head.contains(r#"format="appended""#));
+    assert!(a.contains(r#"format="ascii""#) && !a.contains("AppendedData"));
+    assert!(
+        b.len() * 2 < a.len(),
+        "binary {} B, text {} B",
+        b.len(),
+        a.len()
+    );
+    assert_eq!(run(&["--vtu-ascii"]).status.code(), Some(2));
+}
+
 /// A mesh in another format gets an error that says how to convert it, and the commands it
 /// names (Gmsh's and meshio's, run where their command-line tools are installed) make a `.msh`
 /// that quadrecomb reads.
