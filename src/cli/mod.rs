@@ -43,7 +43,7 @@ enum Command {
     Merge(merge::Args),
     /// Write tables, figures and statistical comparisons for a results directory.
     Report(report::Args),
-    /// Re-run a recorded run of a results directory, check it, and write it as .msh/.vtu.
+    /// Re-run a recorded run of a results directory, check it, and write it as .msh/.vtu (-o: only when the replay reproduces the record).
     Replay(replay::Args),
     /// Print benchmark figures.
     Bench(bench::Args),
@@ -121,6 +121,18 @@ pub fn print_element_lines(
         );
     }
     println!("rule            {rule}");
+}
+
+/// `-o` and `--vtu-ascii`: where a command writes its mesh, and how.
+#[derive(Debug, clap::Args)]
+pub struct MeshOutputArgs {
+    /// Write the resulting mesh (quads and leftover triangles): .msh (MSH 4.1 ASCII) or .vtu.
+    #[arg(short = 'o', long)]
+    pub output: Option<std::path::PathBuf>,
+    /// Write a .vtu's data arrays as text instead of zlib-compressed binary (VTK's own
+    /// default); a .msh is MSH 4.1 ASCII either way.
+    #[arg(long, requires = "output")]
+    pub vtu_ascii: bool,
 }
 
 /// An error in the command line's arguments that clap does not see (a value out of range,

@@ -2,7 +2,6 @@
 
 use quadrecomb::internals::quality::{self, CandidateTable, ElementQuality};
 use quadrecomb::internals::search::optimum;
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, clap::Args)]
@@ -19,21 +18,16 @@ pub struct Args {
     /// slackness); exits with an error if it fails. Not counted in `time_s`.
     #[arg(long)]
     check: bool,
-    /// Write the optimal quad mesh (quads and leftover triangles): .msh (MSH 4.1) or .vtu.
-    #[arg(short = 'o', long)]
-    output: Option<PathBuf>,
-    /// Write a .vtu's data arrays as text instead of zlib-compressed binary (VTK's own
-    /// default); a .msh is MSH 4.1 ASCII either way.
-    #[arg(long, requires = "output")]
-    vtu_ascii: bool,
+    #[command(flatten)]
+    out: super::MeshOutputArgs,
     #[command(flatten)]
     rule: super::RuleArgs,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    super::check_mesh_output(args.output.as_deref())?;
+    super::check_mesh_output(args.out.output.as_deref())?;
     let rule = args.rule.rule()?;
-    super::check_not_input(args.output.as_deref(), &args.mesh)?;
+    super::check_not_input(args.out.output.as_deref(), &args.mesh)?;
     let mesh = quadrecomb::internals::mesh::load(&args.mesh)?;
     let table = CandidateTable::build(&mesh).restrict(&mesh, rule);
     let (opt, report) = optimum::solve_certified(&mesh, &table, args.check);
@@ -49,12 +43,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(Err(e)) => anyhow::bail!("certificate check failed: {e}"),
         None => None,
     };
-    if let Some(path) = &args.output {
+    if let Some(path) = &args.out.output {
         super::write_mesh_output(
             path,
             &mesh,
             &quality::recombined(&mesh, &table, &opt.chosen),
-            args.vtu_ascii,
+            args.out.vtu_ascii,
         )?;
     }
     if args.json {
@@ -97,7 +91,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 r.edges_checked, r.blossoms, r.positive_blossoms
             );
         }
-        if let Some(p) = &args.output {
+        if let Some(p) = &args.out.output {
             println!("wrote           {}", p.display());
         }
     }

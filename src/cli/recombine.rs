@@ -4,7 +4,6 @@ use super::BadInput;
 use quadrecomb::internals::experiment::replay::{self, EtaSource};
 use quadrecomb::internals::quality::{self, CandidateTable, ElementQuality, Rule};
 use quadrecomb::internals::search::{self, Algo, optimum};
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -45,13 +44,8 @@ pub struct Args {
     /// Seed of the run (ChaCha8: the same seed gives the same run everywhere).
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Write the recombined mesh (quads and leftover triangles): .msh (MSH 4.1) or .vtu.
-    #[arg(short = 'o', long)]
-    output: Option<PathBuf>,
-    /// Write a .vtu's data arrays as text instead of zlib-compressed binary (VTK's own
-    /// default); a .msh is MSH 4.1 ASCII either way.
-    #[arg(long, requires = "output")]
-    vtu_ascii: bool,
+    #[command(flatten)]
+    out: super::MeshOutputArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -103,9 +97,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.horizon.is_some() && matches!(algo, Algo::GreedyNocrit | Algo::Greedy) {
         eprintln!("note: --horizon is ignored: {name} looks no further than one action");
     }
-    super::check_mesh_output(args.output.as_deref())?;
+    super::check_mesh_output(args.out.output.as_deref())?;
     let rule = args.rule.rule()?;
-    super::check_not_input(args.output.as_deref(), &args.mesh)?;
+    super::check_not_input(args.out.output.as_deref(), &args.mesh)?;
     use super::oom::{self, Phase};
     oom::phase(Phase::Reading);
     let mesh = quadrecomb::internals::mesh::load(&args.mesh)?;
@@ -128,9 +122,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .as_ref()
         .filter(|o| o.quality > 0.0)
         .map(|o| 100.0 * out.quality / o.quality);
-    if let Some(path) = &args.output {
+    if let Some(path) = &args.out.output {
         let rec = quality::recombined(&mesh, &table, &out.chosen);
-        super::write_mesh_output(path, &mesh, &rec, args.vtu_ascii)?;
+        super::write_mesh_output(path, &mesh, &rec, args.out.vtu_ascii)?;
     }
     let horizon = horizon_of(algo);
     // null where the policy builds no tree (greedy-nocrit), as its sweep record has it.
@@ -186,7 +180,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             _ => println!("nodes expanded  – (no look-ahead tree: {algo} builds none)"),
         }
         println!("time            {:.4} s", out.time_s);
-        if let Some(p) = &args.output {
+        if let Some(p) = &args.out.output {
             println!("wrote           {}", p.display());
         }
     }

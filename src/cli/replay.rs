@@ -26,14 +26,8 @@ pub struct Args {
     /// Horizon of the configuration (default: the smallest recorded).
     #[arg(long)]
     horizon: Option<u32>,
-    /// Write the replayed recombination (quads and leftover triangles): .msh (MSH 4.1) or
-    /// .vtu. Written only when the replay reproduces the record.
-    #[arg(short = 'o', long)]
-    output: Option<PathBuf>,
-    /// Write a .vtu's data arrays as text instead of zlib-compressed binary (VTK's own
-    /// default); a .msh is MSH 4.1 ASCII either way.
-    #[arg(long, requires = "output")]
-    vtu_ascii: bool,
+    #[command(flatten)]
+    out: super::MeshOutputArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -107,7 +101,7 @@ fn spans(indices: impl Iterator<Item = u32>) -> String {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let which = parse_run(&args.run)?;
-    super::check_mesh_output(args.output.as_deref())?;
+    super::check_mesh_output(args.out.output.as_deref())?;
     let results = Results::read(&args.dir)?;
     let (config, runs) = choose_config(&results, &args)?;
     let record = match which {
@@ -134,12 +128,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ))
     };
     if let Some(file) = replayer.mesh_file(record).map_err(cannot)? {
-        super::check_not_input(args.output.as_deref(), &file.to_string_lossy())?;
+        super::check_not_input(args.out.output.as_deref(), &file.to_string_lossy())?;
     }
     let out = replayer.replay(record).map_err(cannot)?;
-    let write = args.output.as_ref().filter(|_| out.reproduced);
+    let write = args.out.output.as_ref().filter(|_| out.reproduced);
     if let Some(path) = write {
-        super::write_mesh_output(path, out.mesh, &out.recombined, args.vtu_ascii)?;
+        super::write_mesh_output(path, out.mesh, &out.recombined, args.out.vtu_ascii)?;
     }
     let typical = matches!(which, Which::Typical);
     let rule = record.rule();
@@ -218,7 +212,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             record.quads,
             record.quality,
             out.eta_note(),
-            if args.output.is_some() {
+            if args.out.output.is_some() {
                 "; nothing written"
             } else {
                 ""
