@@ -113,6 +113,7 @@ fn experiment_code(e: &ExperimentError) -> Option<u8> {
         | E::TornPart { .. }
         | E::OptimumContradicted { .. } => Some(EXIT_BAD_INPUT),
         E::Mismatch { .. }
+        | E::Extendable { .. }
         | E::AlreadyExists { .. }
         | E::MergeTargetNotEmpty { .. }
         | E::NotADirectory { .. }
@@ -153,6 +154,9 @@ fn flag_wording(e: &(dyn Error + 'static)) -> Option<String> {
         e @ E::AlreadyExists { .. } => format!(
             "{e}; pass --resume to continue that sweep, --overwrite to replace it, or choose \
              another --out"
+        ),
+        e @ E::Extendable { .. } => format!(
+            "{e}; pass --extend to add the new configurations to it, or choose another --out"
         ),
         e @ E::MergeTargetNotEmpty { .. } => {
             format!("{e}: choose another --out or remove that one")

@@ -24,6 +24,10 @@ pub struct EngineOptions {
     pub dir: PathBuf,
     /// Continue a sweep already in `dir`.
     pub resume: bool,
+    /// With `resume`: the configuration may extend the directory's (more algorithms,
+    /// horizons or runs, with the same meshes, base seed, rule and plan version); the manifest
+    /// is rewritten with it before any new run starts.
+    pub extend: bool,
     /// Replace the results of an earlier sweep in `dir` (ignored with `resume`): its runs,
     /// manifest, summary, report and figures are removed first; the optimum cache is kept.
     pub overwrite: bool,
@@ -353,6 +357,52 @@ pub fn report_files(dir: &Path) -> Result<Vec<String>, ExperimentError> {
     Ok(out)
 }
 
+/// Refuses to continue the directory whose manifest is `old` with `new`: another shard, or
+/// another configuration ([`Manifest::incompatibility`]); with `extend`, a configuration that
+/// does not extend the old one ([`Manifest::extension_refusal`]). A plain resume whose
+/// configuration would be a valid extension says so ([`ExperimentError::Extendable`]).
+fn check_resume(
+    dir: &Path,
+    old: &Manifest,
+    new: &Manifest,
+    extend: bool,
+) -> Result<(), ExperimentError> {
+    let mismatch = |message: String| ExperimentError::Mismatch {
+        dir: dir.to_path_buf(),
+        message,
+    };
+    if old.shard != new.shard {
+        let s = |s: Option<super::manifest::Shard>| {
+            s.map_or("the whole run list".to_string(), |s| format!("shard {s}"))
+        };
+        return Err(mismatch(format!("{} vs {}", s(new.shard), s(old.shard))));
+    }
+    let Some(why) = new.incompatibility(old) else {
+        return Ok(());
+    };
+    let refusal = new.extension_refusal(old);
+    if extend {
+        if new.shard.is_some() {
+            // A shard is a slice of the whole run list, which an extension changes.
+            return Err(mismatch(format!(
+                "{why}; a shard cannot be extended (its slice is cut from the whole run \
+                 list, which an extension changes): extend the merged directory instead"
+            )));
+        }
+        return match refusal {
+            Some(r) => Err(mismatch(format!("cannot extend it: {r}"))),
+            None => Ok(()),
+        };
+    }
+    if refusal.is_none() && new.shard.is_none() {
+        return Err(ExperimentError::Extendable {
+            dir: dir.to_path_buf(),
+            message: why,
+        });
+    }
+    Err(mismatch(why))
+}
+
 /// Runs the sweep described by `manifest` (its spec and shard) into `opts.dir`.
 ///
 /// A fresh directory must not hold runs yet; with `resume`, its manifest must describe the
@@ -374,23 +424,24 @@ pub fn run(
     }
     let runs_path = dir.join(RUNS_FILE);
     let loaded = store::read(&runs_path)?;
+    let mut manifest = manifest.clone();
     if dir.join(MANIFEST_FILE).exists() {
         let old = Manifest::read(dir)?;
         if opts.resume {
-            let why = manifest.incompatibility(&old).or_else(|| {
-                (old.shard != manifest.shard).then(|| {
-                    let s = |s: Option<super::manifest::Shard>| {
-                        s.map_or("the whole run list".to_string(), |s| format!("shard {s}"))
-                    };
-                    format!("{} vs {}", s(manifest.shard), s(old.shard))
-                })
-            });
-            if let Some(message) = why {
-                return Err(ExperimentError::Mismatch {
-                    dir: dir.clone(),
-                    message,
+            check_resume(dir, &old, &manifest, opts.extend)?;
+            // The records are checked against the directory's own manifest before it is
+            // rewritten: a refused directory keeps its manifest. An extension plans every run
+            // of the old list with the same seed (checked above), so they stay valid.
+            let old_jobs = shard(plan(&old.spec), old.shard);
+            check_records(dir, &old, &old_jobs, &loaded, true)?;
+            if old.spec != manifest.spec {
+                events(Event::Extending {
+                    before: old_jobs.len(),
+                    after: shard(plan(&manifest.spec), manifest.shard).len(),
                 });
             }
+            // A merged directory keeps the list of the parts it was made of.
+            manifest.merged_from = old.merged_from;
         } else if !loaded.records.is_empty() || loaded.torn_bytes > 0 {
             return Err(ExperimentError::AlreadyExists {
                 dir: dir.clone(),
@@ -403,7 +454,11 @@ pub fn run(
             message: format!("{} exists without {MANIFEST_FILE}", RUNS_FILE),
         });
     }
+    // Written whole (a temporary file renamed over the old one), before any new run is
+    // appended: a kill leaves either manifest, and the records are a part of the run list of
+    // either, which the next --resume completes.
     manifest.write(dir)?;
+    let manifest = &manifest;
 
     let jobs = shard(plan(&manifest.spec), manifest.shard);
     let done = check_records(dir, manifest, &jobs, &loaded, true)?;
@@ -493,6 +548,7 @@ pub(crate) mod tests {
         EngineOptions {
             dir: dir.to_path_buf(),
             resume,
+            extend: false,
             overwrite: false,
             threads,
         }
