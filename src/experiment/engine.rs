@@ -634,6 +634,47 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn extend_adds_runs_keeps_the_records_and_refuses_to_drop_any() {
+        let tmp = tempfile::tempdir().unwrap();
+        let m = manifest(None);
+        let no = AtomicBool::new(false);
+        run(&m, &OK, &opts(tmp.path(), 2, false), &no, &mut |_| {}).unwrap();
+        let before = std::fs::read(tmp.path().join(RUNS_FILE)).unwrap();
+        let mut wider = m.clone();
+        wider.spec.horizons.push(4);
+        wider.spec.runs = 6;
+        // A plain resume says the configuration would extend the directory, and does nothing.
+        let err = run(&wider, &OK, &opts(tmp.path(), 1, true), &no, &mut |_| {}).unwrap_err();
+        assert!(matches!(err, ExperimentError::Extendable { .. }), "{err}");
+        assert_eq!(Manifest::read(tmp.path()).unwrap().spec, m.spec);
+        let mut o = opts(tmp.path(), 2, true);
+        o.extend = true;
+        let mut seen = Vec::new();
+        let rep = run(&wider, &OK, &o, &no, &mut |e| seen.push(format!("{e:?}"))).unwrap();
+        // 2 meshes x (4 horizons x 6 runs + 2 + 2 + 1) planned, 40 of them recorded before.
+        assert_eq!((rep.planned, rep.already, rep.done_now), (58, 40, 18));
+        assert_eq!(seen[0], "Extending { before: 40, after: 58 }");
+        let after = std::fs::read(tmp.path().join(RUNS_FILE)).unwrap();
+        assert!(after.starts_with(&before));
+        assert_eq!(Manifest::read(tmp.path()).unwrap().spec, wider.spec);
+        let fresh = tmp.path().join("fresh");
+        run(&wider, &OK, &opts(&fresh, 1, false), &no, &mut |_| {}).unwrap();
+        assert_eq!(sorted(tmp.path()), sorted(&fresh));
+        // Back to fewer runs: refused, naming what would be dropped.
+        let err = run(&m, &OK, &o, &no, &mut |_| {}).unwrap_err().to_string();
+        assert!(
+            err.contains("would drop runs") && err.contains("a selective h=1: run 5"),
+            "{err}"
+        );
+        let mut seed = wider.clone();
+        seed.spec.seed += 1;
+        let err = run(&seed, &OK, &o, &no, &mut |_| {})
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("cannot extend it: seed 10 vs 9"), "{err}");
+    }
+
+    #[test]
     fn cancelled_sweep_keeps_what_finished_and_resumes() {
         let tmp = tempfile::tempdir().unwrap();
         let m = manifest(None);

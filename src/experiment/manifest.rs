@@ -446,3 +446,40 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dropped_runs_and_union() {
+        let a = crate::experiment::plan::tests::spec();
+        let mut b = a.clone();
+        b.algos = vec!["selective".into(), "uniform".into()];
+        b.horizons = vec![3, 4];
+        b.runs = 7;
+        b.baseline_runs = 1;
+        assert_eq!(base_difference(&a, &b), None);
+        let dropped = dropped_runs(&a, &b);
+        assert_eq!(dropped[0], "a greedy: runs 0..1");
+        assert!(dropped.contains(&"b selective h=1: runs 0..4".to_string()));
+        assert!(dropped_runs(&a, &a).is_empty());
+        let u = union_spec(&a, &b);
+        assert_eq!(
+            u.algos,
+            ["selective", "greedy", "greedy-nocrit", "optimum", "uniform"]
+        );
+        assert_eq!(
+            (u.horizons.clone(), u.runs, u.baseline_runs),
+            (vec![1, 2, 3, 4], 7, 2)
+        );
+        assert!(dropped_runs(&a, &u).is_empty() && dropped_runs(&b, &u).is_empty());
+        // A spec without a randomized tree has no runs count to contribute.
+        let mut g = a.clone();
+        g.algos = vec!["greedy".into()];
+        g.runs = 100;
+        assert_eq!(union_spec(&a, &g).runs, a.runs);
+        g.seed += 1;
+        assert_eq!(base_difference(&a, &g), Some("seed 9 vs 10".into()));
+    }
+}
