@@ -208,6 +208,19 @@ mod tests {
             }),
             EXIT_FAILURE
         );
+        let extendable = ExperimentError::Extendable {
+            dir: dir.clone(),
+            message: "horizons [1, 2, 3] vs [1, 2]".into(),
+        };
+        let e = anyhow::Error::new(extendable);
+        assert_eq!(exit_code(&e), EXIT_RESULTS_DIR);
+        assert!(
+            describe(&e).ends_with(
+                "pass --extend to add the new configurations to it, or choose another --out"
+            ),
+            "{}",
+            describe(&e)
+        );
         let report = ReportError::Results(ExperimentError::AlreadyExists { dir, records: 1 });
         assert_eq!(exit_code(&report.into()), EXIT_RESULTS_DIR);
         assert_eq!(exit_code(&BadInput("x".into()).into()), EXIT_USAGE);
