@@ -113,6 +113,7 @@ fn experiment_code(e: &ExperimentError) -> Option<u8> {
         | E::TornPart { .. }
         | E::OptimumContradicted { .. } => Some(EXIT_BAD_INPUT),
         E::Mismatch { .. }
+        | E::Extendable { .. }
         | E::AlreadyExists { .. }
         | E::MergeTargetNotEmpty { .. }
         | E::NotADirectory { .. }
@@ -153,6 +154,9 @@ fn flag_wording(e: &(dyn Error + 'static)) -> Option<String> {
         e @ E::AlreadyExists { .. } => format!(
             "{e}; pass --resume to continue that sweep, --overwrite to replace it, or choose \
              another --out"
+        ),
+        e @ E::Extendable { .. } => format!(
+            "{e}; pass --extend to add the new configurations to it, or choose another --out"
         ),
         e @ E::MergeTargetNotEmpty { .. } => {
             format!("{e}: choose another --out or remove that one")
@@ -203,6 +207,19 @@ mod tests {
                 source: std::io::Error::other("x")
             }),
             EXIT_FAILURE
+        );
+        let extendable = ExperimentError::Extendable {
+            dir: dir.clone(),
+            message: "horizons [1, 2, 3] vs [1, 2]".into(),
+        };
+        let e = anyhow::Error::new(extendable);
+        assert_eq!(exit_code(&e), EXIT_RESULTS_DIR);
+        assert!(
+            describe(&e).ends_with(
+                "pass --extend to add the new configurations to it, or choose another --out"
+            ),
+            "{}",
+            describe(&e)
         );
         let report = ReportError::Results(ExperimentError::AlreadyExists { dir, records: 1 });
         assert_eq!(exit_code(&report.into()), EXIT_RESULTS_DIR);

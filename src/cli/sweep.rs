@@ -78,8 +78,12 @@ pub struct Args {
     /// Continue the sweep in --out, skipping the runs it already recorded.
     #[arg(long)]
     resume: bool,
+    /// Continue the sweep in --out with more algorithms, horizons or runs (same meshes, base
+    /// seed and rule): the recorded runs are kept, the new ones added (implies --resume).
+    #[arg(long, conflicts_with = "shard")]
+    extend: bool,
     /// Replace the results of an earlier sweep in --out (runs, summary, report, figures).
-    #[arg(long, conflicts_with = "resume")]
+    #[arg(long, conflicts_with_all = ["resume", "extend"])]
     overwrite: bool,
     /// Run only the I-th of N disjoint slices of the run list (1 <= I <= N).
     #[arg(long, value_name = "I/N")]
@@ -197,6 +201,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         rule: args.rule.rule()?,
         out: out.clone(),
         resume: args.resume,
+        extend: args.extend,
         overwrite: args.overwrite,
         shard: args.shard,
     })
@@ -261,10 +266,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             json(serde_json::Value::Null);
         }
         eprintln!(
-            "sweep: interrupted: {} of {} runs recorded in {}{shard}; run the same command with --resume to finish",
+            "sweep: interrupted: {} of {} runs recorded in {}{shard}; run the same command with {} to finish",
             report.already + report.done_now,
             report.planned,
-            out.display()
+            out.display(),
+            if args.extend { "--extend" } else { "--resume" }
         );
         return Ok(ExitCode::from(EXIT_INTERRUPTED));
     }

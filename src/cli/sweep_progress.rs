@@ -57,6 +57,14 @@ impl SweepDisplay {
                     eprintln!("quality backend: {note}");
                 }
             }
+            Event::Extending { before, after } => {
+                if self.mode != ProgressMode::Quiet {
+                    eprintln!(
+                        "sweep: extending the sweep: its run list grows from {before} to {after} \
+                         runs (the recorded ones are kept)"
+                    );
+                }
+            }
             Event::Resuming {
                 recorded,
                 planned,

@@ -54,6 +54,10 @@ pub struct SweepRequest {
     pub out: PathBuf,
     /// Continue the sweep in `out`.
     pub resume: bool,
+    /// Continue the sweep in `out` with this configuration, which may add algorithms,
+    /// horizons and runs to the directory's (same meshes, base seed and rule; implies
+    /// `resume`).
+    pub extend: bool,
     /// Replace an earlier sweep's results in `out`: its runs, manifest, summary, report and
     /// figures (ignored with `resume`).
     pub overwrite: bool,
@@ -75,6 +79,7 @@ impl Default for SweepRequest {
             rule: Rule::default(),
             out: PathBuf::from("results/borouchaki"),
             resume: false,
+            extend: false,
             overwrite: false,
             shard: None,
         }
@@ -297,12 +302,17 @@ impl SweepConfig {
 
     /// Whether the sweep in [`Self::out`] is continued.
     pub fn resume(&self) -> bool {
-        self.0.resume
+        self.0.resume || self.0.extend
+    }
+
+    /// Whether the sweep in [`Self::out`] may be extended to this configuration.
+    pub fn extend(&self) -> bool {
+        self.0.extend
     }
 
     /// Whether an earlier sweep's results in [`Self::out`] are replaced (not with resume).
     pub fn overwrite(&self) -> bool {
-        self.0.overwrite && !self.0.resume
+        self.0.overwrite && !self.resume()
     }
 
     /// The slice of the run list to run, if not all of it.
@@ -335,7 +345,8 @@ impl SweepConfig {
     pub fn engine_options(&self) -> EngineOptions {
         EngineOptions {
             dir: self.0.out.clone(),
-            resume: self.0.resume,
+            resume: self.resume(),
+            extend: self.0.extend,
             overwrite: self.overwrite(),
             threads: self.0.threads,
         }

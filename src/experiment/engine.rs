@@ -24,6 +24,10 @@ pub struct EngineOptions {
     pub dir: PathBuf,
     /// Continue a sweep already in `dir`.
     pub resume: bool,
+    /// With `resume`: the configuration may extend the directory's (more algorithms,
+    /// horizons or runs, with the same meshes, base seed, rule and plan version); the manifest
+    /// is rewritten with it before any new run starts.
+    pub extend: bool,
     /// Replace the results of an earlier sweep in `dir` (ignored with `resume`): its runs,
     /// manifest, summary, report and figures are removed first; the optimum cache is kept.
     pub overwrite: bool,
@@ -353,6 +357,52 @@ pub fn report_files(dir: &Path) -> Result<Vec<String>, ExperimentError> {
     Ok(out)
 }
 
+/// Refuses to continue the directory whose manifest is `old` with `new`: another shard, or
+/// another configuration ([`Manifest::incompatibility`]); with `extend`, a configuration that
+/// does not extend the old one ([`Manifest::extension_refusal`]). A plain resume whose
+/// configuration would be a valid extension says so ([`ExperimentError::Extendable`]).
+fn check_resume(
+    dir: &Path,
+    old: &Manifest,
+    new: &Manifest,
+    extend: bool,
+) -> Result<(), ExperimentError> {
+    let mismatch = |message: String| ExperimentError::Mismatch {
+        dir: dir.to_path_buf(),
+        message,
+    };
+    if old.shard != new.shard {
+        let s = |s: Option<super::manifest::Shard>| {
+            s.map_or("the whole run list".to_string(), |s| format!("shard {s}"))
+        };
+        return Err(mismatch(format!("{} vs {}", s(new.shard), s(old.shard))));
+    }
+    let Some(why) = new.incompatibility(old) else {
+        return Ok(());
+    };
+    let refusal = new.extension_refusal(old);
+    if extend {
+        if new.shard.is_some() {
+            // A shard is a slice of the whole run list, which an extension changes.
+            return Err(mismatch(format!(
+                "{why}; a shard cannot be extended (its slice is cut from the whole run \
+                 list, which an extension changes): extend the merged directory instead"
+            )));
+        }
+        return match refusal {
+            Some(r) => Err(mismatch(format!("cannot extend it: {r}"))),
+            None => Ok(()),
+        };
+    }
+    if refusal.is_none() && new.shard.is_none() {
+        return Err(ExperimentError::Extendable {
+            dir: dir.to_path_buf(),
+            message: why,
+        });
+    }
+    Err(mismatch(why))
+}
+
 /// Runs the sweep described by `manifest` (its spec and shard) into `opts.dir`.
 ///
 /// A fresh directory must not hold runs yet; with `resume`, its manifest must describe the
@@ -374,23 +424,24 @@ pub fn run(
     }
     let runs_path = dir.join(RUNS_FILE);
     let loaded = store::read(&runs_path)?;
+    let mut manifest = manifest.clone();
     if dir.join(MANIFEST_FILE).exists() {
         let old = Manifest::read(dir)?;
         if opts.resume {
-            let why = manifest.incompatibility(&old).or_else(|| {
-                (old.shard != manifest.shard).then(|| {
-                    let s = |s: Option<super::manifest::Shard>| {
-                        s.map_or("the whole run list".to_string(), |s| format!("shard {s}"))
-                    };
-                    format!("{} vs {}", s(manifest.shard), s(old.shard))
-                })
-            });
-            if let Some(message) = why {
-                return Err(ExperimentError::Mismatch {
-                    dir: dir.clone(),
-                    message,
+            check_resume(dir, &old, &manifest, opts.extend)?;
+            // The records are checked against the directory's own manifest before it is
+            // rewritten: a refused directory keeps its manifest. An extension plans every run
+            // of the old list with the same seed (checked above), so they stay valid.
+            let old_jobs = shard(plan(&old.spec), old.shard);
+            check_records(dir, &old, &old_jobs, &loaded, true)?;
+            if old.spec != manifest.spec {
+                events(Event::Extending {
+                    before: old_jobs.len(),
+                    after: shard(plan(&manifest.spec), manifest.shard).len(),
                 });
             }
+            // A merged directory keeps the list of the parts it was made of.
+            manifest.merged_from = old.merged_from;
         } else if !loaded.records.is_empty() || loaded.torn_bytes > 0 {
             return Err(ExperimentError::AlreadyExists {
                 dir: dir.clone(),
@@ -403,7 +454,11 @@ pub fn run(
             message: format!("{} exists without {MANIFEST_FILE}", RUNS_FILE),
         });
     }
+    // Written whole (a temporary file renamed over the old one), before any new run is
+    // appended: a kill leaves either manifest, and the records are a part of the run list of
+    // either, which the next --resume completes.
     manifest.write(dir)?;
+    let manifest = &manifest;
 
     let jobs = shard(plan(&manifest.spec), manifest.shard);
     let done = check_records(dir, manifest, &jobs, &loaded, true)?;
@@ -493,6 +548,7 @@ pub(crate) mod tests {
         EngineOptions {
             dir: dir.to_path_buf(),
             resume,
+            extend: false,
             overwrite: false,
             threads,
         }
@@ -575,6 +631,47 @@ pub(crate) mod tests {
             err.to_string().contains("shard 1/2 vs the whole run list"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn extend_adds_runs_keeps_the_records_and_refuses_to_drop_any() {
+        let tmp = tempfile::tempdir().unwrap();
+        let m = manifest(None);
+        let no = AtomicBool::new(false);
+        run(&m, &OK, &opts(tmp.path(), 2, false), &no, &mut |_| {}).unwrap();
+        let before = std::fs::read(tmp.path().join(RUNS_FILE)).unwrap();
+        let mut wider = m.clone();
+        wider.spec.horizons.push(4);
+        wider.spec.runs = 6;
+        // A plain resume says the configuration would extend the directory, and does nothing.
+        let err = run(&wider, &OK, &opts(tmp.path(), 1, true), &no, &mut |_| {}).unwrap_err();
+        assert!(matches!(err, ExperimentError::Extendable { .. }), "{err}");
+        assert_eq!(Manifest::read(tmp.path()).unwrap().spec, m.spec);
+        let mut o = opts(tmp.path(), 2, true);
+        o.extend = true;
+        let mut seen = Vec::new();
+        let rep = run(&wider, &OK, &o, &no, &mut |e| seen.push(format!("{e:?}"))).unwrap();
+        // 2 meshes x (4 horizons x 6 runs + 2 + 2 + 1) planned, 40 of them recorded before.
+        assert_eq!((rep.planned, rep.already, rep.done_now), (58, 40, 18));
+        assert_eq!(seen[0], "Extending { before: 40, after: 58 }");
+        let after = std::fs::read(tmp.path().join(RUNS_FILE)).unwrap();
+        assert!(after.starts_with(&before));
+        assert_eq!(Manifest::read(tmp.path()).unwrap().spec, wider.spec);
+        let fresh = tmp.path().join("fresh");
+        run(&wider, &OK, &opts(&fresh, 1, false), &no, &mut |_| {}).unwrap();
+        assert_eq!(sorted(tmp.path()), sorted(&fresh));
+        // Back to fewer runs: refused, naming what would be dropped.
+        let err = run(&m, &OK, &o, &no, &mut |_| {}).unwrap_err().to_string();
+        assert!(
+            err.contains("would drop runs") && err.contains("a selective h=1: run 5"),
+            "{err}"
+        );
+        let mut seed = wider.clone();
+        seed.spec.seed += 1;
+        let err = run(&seed, &OK, &o, &no, &mut |_| {})
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("cannot extend it: seed 10 vs 9"), "{err}");
     }
 
     #[test]

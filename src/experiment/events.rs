@@ -8,6 +8,13 @@ use crate::gpu::BackendNote;
 pub enum Event<'a> {
     /// How the quality backend was chosen (with [`crate::gpu::Backend::Auto`]).
     Backend(&'a BackendNote),
+    /// A sweep extends its directory's configuration: its run list grows.
+    Extending {
+        /// Runs in the directory's run list before.
+        before: usize,
+        /// Runs in the extended run list.
+        after: usize,
+    },
     /// A resumed sweep found runs already recorded.
     Resuming {
         /// Runs found recorded.

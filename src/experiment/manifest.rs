@@ -291,6 +291,117 @@ impl Manifest {
         }
         spec_difference(&self.spec, &other.spec)
     }
+
+    /// Why `other` cannot be combined with `self` even as an extension (or a merge of
+    /// different configurations): another version or backend, or a difference in what fixes
+    /// the existing runs' seeds and results ([`base_difference`]).
+    pub fn base_incompatibility(&self, other: &Manifest) -> Option<String> {
+        let mut same = other.clone();
+        same.spec = self.spec.clone();
+        self.incompatibility(&same)
+            .or_else(|| base_difference(&self.spec, &other.spec))
+    }
+
+    /// Why this configuration cannot extend the directory whose manifest is `old`, if it
+    /// cannot: another version, backend, mesh, base seed, rule or plan version
+    /// ([`Self::base_incompatibility`], worded this one's vs `old`'s), or a run recorded under
+    /// `old` that this one would not plan ([`dropped_runs`]).
+    pub fn extension_refusal(&self, old: &Manifest) -> Option<String> {
+        if let Some(why) = self.base_incompatibility(old) {
+            return Some(format!("{why} (this sweep's vs the directory's)"));
+        }
+        let dropped = dropped_runs(&old.spec, &self.spec);
+        (!dropped.is_empty()).then(|| {
+            const SHOWN: usize = 6;
+            let more = dropped.len().saturating_sub(SHOWN);
+            format!(
+                "it would drop runs the directory holds: {}{} (an extension keeps every \
+                 configuration and run: give them again)",
+                dropped[..dropped.len().min(SHOWN)].join("; "),
+                if more > 0 {
+                    format!("; and {more} more configurations")
+                } else {
+                    String::new()
+                }
+            )
+        })
+    }
+}
+
+/// The first difference between two specs in what decides the seeds and results of the runs
+/// they share: the meshes (by name, hash and size), the base seed, the rule and the plan
+/// version. Specs without one may hold different algorithms, horizons and run counts: every
+/// run they have in common is the same run.
+pub fn base_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
+    let mut b2 = a.clone();
+    b2.meshes = b.meshes.clone();
+    b2.seed = b.seed;
+    b2.min_eta = b.min_eta;
+    b2.allow_invalid = b.allow_invalid;
+    b2.plan_version = b.plan_version;
+    spec_difference(a, &b2)
+}
+
+/// The configurations of `old`'s run list that `new`'s lacks, in words, one item per
+/// configuration ("mesh selective h=3: runs 3..4"); empty when `new` plans every run of `old`.
+/// Specs must agree on [`base_difference`] (then shared runs have the same seeds).
+pub fn dropped_runs(old: &SweepSpec, new: &SweepSpec) -> Vec<String> {
+    use std::collections::{BTreeMap, BTreeSet};
+    let planned: BTreeSet<_> = super::plan::plan(new).iter().map(|j| j.key(new)).collect();
+    let mut missing: BTreeMap<(String, String, Option<u32>), Vec<u32>> = BTreeMap::new();
+    for job in super::plan::plan(old) {
+        let key = job.key(old);
+        if !planned.contains(&key) {
+            missing
+                .entry((key.mesh, key.algo, key.horizon))
+                .or_default()
+                .push(key.run);
+        }
+    }
+    missing
+        .into_iter()
+        .map(|((mesh, algo, horizon), runs)| {
+            let h = horizon.map_or(String::new(), |h| format!(" h={h}"));
+            let (first, last) = (runs[0], runs[runs.len() - 1]);
+            let which = if runs.len() == 1 {
+                format!("run {first}")
+            } else if last - first + 1 == runs.len() as u32 {
+                format!("runs {first}..{last}")
+            } else {
+                format!("{} runs", runs.len())
+            };
+            format!("{mesh} {algo}{h}: {which}")
+        })
+        .collect()
+}
+
+/// The union of two specs that agree on [`base_difference`]: `a`'s algorithms and horizons
+/// then those only `b` has, and the larger run counts of the two, each taken only from a spec
+/// that uses it (a spec without a randomized tree algorithm has no `runs` to contribute).
+pub fn union_spec(a: &SweepSpec, b: &SweepSpec) -> SweepSpec {
+    use super::plan::{uses_baseline_runs, uses_runs};
+    let mut u = a.clone();
+    for algo in &b.algos {
+        if !u.algos.contains(algo) {
+            u.algos.push(algo.clone());
+        }
+    }
+    for h in &b.horizons {
+        if !u.horizons.contains(h) {
+            u.horizons.push(*h);
+        }
+    }
+    u.runs = match (uses_runs(a), uses_runs(b)) {
+        (true, true) => a.runs.max(b.runs),
+        (false, true) => b.runs,
+        _ => a.runs,
+    };
+    u.baseline_runs = match (uses_baseline_runs(a), uses_baseline_runs(b)) {
+        (true, true) => a.baseline_runs.max(b.baseline_runs),
+        (false, true) => b.baseline_runs,
+        _ => a.baseline_runs,
+    };
+    u
 }
 
 /// The first difference between two specs, in words.
@@ -334,4 +445,41 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
         ));
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dropped_runs_and_union() {
+        let a = crate::experiment::plan::tests::spec();
+        let mut b = a.clone();
+        b.algos = vec!["selective".into(), "uniform".into()];
+        b.horizons = vec![3, 4];
+        b.runs = 7;
+        b.baseline_runs = 1;
+        assert_eq!(base_difference(&a, &b), None);
+        let dropped = dropped_runs(&a, &b);
+        assert_eq!(dropped[0], "a greedy: runs 0..1");
+        assert!(dropped.contains(&"b selective h=1: runs 0..4".to_string()));
+        assert!(dropped_runs(&a, &a).is_empty());
+        let u = union_spec(&a, &b);
+        assert_eq!(
+            u.algos,
+            ["selective", "greedy", "greedy-nocrit", "optimum", "uniform"]
+        );
+        assert_eq!(
+            (u.horizons.clone(), u.runs, u.baseline_runs),
+            (vec![1, 2, 3, 4], 7, 2)
+        );
+        assert!(dropped_runs(&a, &u).is_empty() && dropped_runs(&b, &u).is_empty());
+        // A spec without a randomized tree has no runs count to contribute.
+        let mut g = a.clone();
+        g.algos = vec!["greedy".into()];
+        g.runs = 100;
+        assert_eq!(union_spec(&a, &g).runs, a.runs);
+        g.seed += 1;
+        assert_eq!(base_difference(&a, &g), Some("seed 9 vs 10".into()));
+    }
 }

@@ -1,8 +1,12 @@
-//! Merging the results directories of shards (or any disjoint parts) of one sweep.
+//! Merging the results directories of shards of one sweep, or of sweeps that extend each other.
 //!
-//! The parts must have the same configuration (spec, backend, version); together they must hold
-//! every run of the run list exactly once. The merged directory gets the runs in canonical
-//! order, a manifest naming the parts and their machines, and a fresh summary.
+//! The parts must agree on the version, backend, meshes, base seed, rule and plan version;
+//! their configurations may differ (a directory and its extension, shards of sweeps with other
+//! horizons): the merged directory's is their union, and together the parts must hold every run
+//! of its run list. Shards of one configuration hold disjoint runs; a run that parts of
+//! different configurations share is the same run (all fields but time) and is kept once, from
+//! the first part given. The merged directory gets the runs in canonical order, a manifest
+//! naming the parts and their machines, and a fresh summary.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -57,8 +61,10 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     }
     let first = &manifests[0];
     for (p, m) in parts.iter().zip(&manifests).skip(1) {
+        // Shards of one configuration are cut from one run list with one shard count.
         if let (Some(a), Some(b)) = (first.shard, m.shard)
             && a.count != b.count
+            && first.spec == m.spec
         {
             return Err(ExperimentError::Merge(format!(
                 "{} is shard {}/{} but {} is shard {}/{}: shards of one sweep are cut with the same shard count",
@@ -70,15 +76,40 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
                 b.count
             )));
         }
-        if let Some(why) = first.incompatibility(m) {
+        if let Some(why) = first.base_incompatibility(m) {
             return Err(ExperimentError::Merge(format!(
                 "{} and {} are not parts of the same sweep: {why}",
                 parts[0].display(),
                 p.display()
             )));
         }
+        for (a, b) in first.optimum.iter().zip(&m.optimum) {
+            if a.eta_hash != b.eta_hash {
+                return Err(ExperimentError::Merge(format!(
+                    "{} and {} computed the optimum of {} from different eta",
+                    parts[0].display(),
+                    p.display(),
+                    a.mesh
+                )));
+            }
+        }
     }
-    let jobs = plan(&first.spec);
+    // Parts of different configurations (a directory and its extension, or shards of
+    // sweeps that add horizons, algorithms or runs to each other) merge into the union of
+    // their configurations; the runs they share are the same runs (same seeds).
+    let mut spec = first.spec.clone();
+    for m in &manifests[1..] {
+        spec = super::manifest::union_spec(&spec, &m.spec);
+    }
+    super::config::check_size(
+        spec.meshes.len(),
+        &spec.algos,
+        spec.horizons.len(),
+        spec.runs,
+        spec.baseline_runs,
+    )
+    .map_err(|e| ExperimentError::Merge(format!("the union of the parts' configurations: {e}")))?;
+    let jobs = plan(&spec);
     let mut by_key: BTreeMap<RunKey, (RunRecord, String, usize)> = BTreeMap::new();
     let mut merged_from = Vec::new();
     for (i, (p, m)) in parts.iter().zip(&manifests).enumerate() {
@@ -88,17 +119,29 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
                 path: p.join(RUNS_FILE),
             });
         }
-        // Every record must be a run of the whole list with the right seed (a shard's records
-        // are runs of the whole list too).
-        check_records(p, m, &jobs, &loaded, true)?;
+        // Every record must be a run of its part's whole list with the right seed (a shard's
+        // records are runs of the whole list too).
+        check_records(p, m, &plan(&m.spec), &loaded, true)?;
         for (r, line) in loaded.records.iter().zip(&loaded.lines) {
-            if let Some((_, _, j)) = by_key.get(&r.key()) {
-                return Err(ExperimentError::Merge(format!(
-                    "run {} is in both {} and {}",
-                    r.key(),
-                    parts[*j].display(),
-                    p.display()
-                )));
+            if let Some((earlier, _, j)) = by_key.get(&r.key()) {
+                // Shards of one configuration are disjoint: a run in two of them means a
+                // part given twice (or copied). Parts of different configurations overlap
+                // where one extends the other; a shared run must be the same run.
+                let (pj, pi) = (parts[*j].display(), p.display());
+                if manifests[*j].spec == m.spec {
+                    return Err(ExperimentError::Merge(format!(
+                        "run {} is in both {pj} and {pi}",
+                        r.key()
+                    )));
+                }
+                if !earlier.same_result(r) {
+                    return Err(ExperimentError::Merge(format!(
+                        "run {} is in both {pj} and {pi} with different results (every field \
+                         but time_s should agree)",
+                        r.key()
+                    )));
+                }
+                continue;
             }
             by_key.insert(r.key(), (r.clone(), line.clone(), i));
         }
@@ -111,13 +154,18 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     }
     let missing: Vec<RunKey> = jobs
         .iter()
-        .map(|j| j.key(&first.spec))
+        .map(|j| j.key(&spec))
         .filter(|k| !by_key.contains_key(k))
         .collect();
     if !missing.is_empty() {
         let list: Vec<String> = missing.iter().take(5).map(|k| k.to_string()).collect();
+        let union = if manifests.iter().any(|m| m.spec != spec) {
+            " of the union of the parts' configurations"
+        } else {
+            ""
+        };
         return Err(ExperimentError::Merge(format!(
-            "{} of {} runs are missing (a shard not given, not finished, or cut with another shard count?), e.g.: {}",
+            "{} of {} runs{union} are missing (a shard not given, not finished, or cut with another shard count?), e.g.: {}",
             missing.len(),
             jobs.len(),
             list.join("; ")
@@ -134,6 +182,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
         });
     }
     let mut manifest = first.clone();
+    manifest.spec = spec.clone();
     manifest.shard = None;
     manifest.threads = manifests.iter().map(|m| m.threads).max().unwrap_or(1);
     manifest.machine = super::manifest::Machine::current();
@@ -142,9 +191,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     let mut log = RunLog::create(&out_runs)?;
     let mut records = Vec::with_capacity(jobs.len());
     for j in &jobs {
-        let (r, line, _) = by_key
-            .remove(&j.key(&first.spec))
-            .expect("checked: none missing");
+        let (r, line, _) = by_key.remove(&j.key(&spec)).expect("checked: none missing");
         log.append_line(&line)?;
         records.push(r);
     }

@@ -52,6 +52,18 @@ pub enum ExperimentError {
         /// The first difference found.
         message: String,
     },
+    /// A results directory is resumed with a configuration that is not its own but would
+    /// extend it (more algorithms, horizons or runs; same meshes, base seed and rule).
+    #[error(
+        "{dir}: holds results of a different configuration: {message} (the new one \
+         extends it: every run recorded there is one of its runs)"
+    )]
+    Extendable {
+        /// The directory.
+        dir: PathBuf,
+        /// The first difference found.
+        message: String,
+    },
     /// A results directory's records do not fit its own manifest (runs of another sweep,
     /// shard, seed or rule).
     #[error("{dir}: holds results of a different configuration: {message}")]

@@ -16,6 +16,23 @@ pub fn deterministic(algo: &str) -> bool {
     matches!(algo, "greedy" | "greedy-nocrit" | "uniform" | "optimum")
 }
 
+/// Whether `spec`'s run list uses its `runs` (a randomized tree algorithm: `selective`, and
+/// `uniform` in plan version 1).
+pub fn uses_runs(spec: &SweepSpec) -> bool {
+    spec.algos
+        .iter()
+        .any(|a| a == "selective" || (a == "uniform" && spec.plan_version < 2))
+}
+
+/// Whether `spec`'s run list uses its `baseline_runs` (a deterministic configuration other
+/// than the optimum).
+pub fn uses_baseline_runs(spec: &SweepSpec) -> bool {
+    spec.algos.iter().any(|a| {
+        matches!(a.as_str(), "greedy" | "greedy-nocrit")
+            || (a == "uniform" && spec.plan_version >= 2)
+    })
+}
+
 /// Runs per configuration of `algo` (per horizon for the trees) under plan `version`.
 fn runs_of(algo: &str, version: u32, runs: u32, baseline_runs: u32) -> u32 {
     match algo {

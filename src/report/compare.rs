@@ -1,5 +1,7 @@
 //! The comparison section: one results directory against another, configuration by
-//! configuration (`report --compare`).
+//! configuration (`report --compare`). The configurations only one directory has are listed;
+//! those both hold with the very same runs (a directory and its extension) are named and left
+//! out of the tests.
 
 use super::mesh_section::family_blocks;
 use super::significance::Family;
@@ -54,10 +56,54 @@ pub(super) fn compare_section(doc: &mut Document, a: &Results, b: &Results, seed
             ));
         }
     }
+    // A directory and its extension (or a merge of it) hold the same runs where their
+    // configurations overlap: the same seeds, so the same results but for the time. Testing a
+    // sample against itself says nothing, and would weigh on the Holm correction of the rest.
+    let label = |c: &Config| format!("{} {}", c.mesh, c.label());
+    let shared_runs = |ra: &[Run], rb: &[Run]| {
+        ra.iter()
+            .filter(|x| {
+                rb.iter()
+                    .any(|y| y.run == x.run && y.seed == x.seed && x.same_result(y))
+            })
+            .count()
+    };
+    let mut same = Vec::new();
+    let mut overlapping = Vec::new();
+    common.retain(|(c, ra, rb)| {
+        let shared = shared_runs(ra, rb);
+        if shared == ra.len() && shared == rb.len() {
+            same.push(label(c));
+            return false;
+        }
+        if shared > 0 {
+            overlapping.push(format!("{} ({shared} runs)", label(c)));
+        }
+        true
+    });
+    if !same.is_empty() {
+        notes.push(format!(
+            "The same runs in both (same seeds and results, only time_s differs, as in a \
+             directory and its extension), not tested: {}.",
+            same.join(", ")
+        ));
+    }
+    if !overlapping.is_empty() {
+        notes.push(format!(
+            "Runs shared by both (same seeds and results), so the two samples are not \
+             independent: {}.",
+            overlapping.join(", ")
+        ));
+    }
     notes.dedup();
     doc.list(notes);
     if common.is_empty() {
-        doc.para("The two directories share no configuration: nothing to compare.");
+        doc.para(if same.is_empty() {
+            "The two directories share no configuration: nothing to compare."
+        } else {
+            "The configurations the two directories share hold the same runs: nothing to \
+             compare."
+        });
         return;
     }
     let mut families = Vec::new();

@@ -10,7 +10,7 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// A small generated mesh with an odd component, written into `dir`.
-fn small_mesh(dir: &Path, triangles: usize) -> PathBuf {
+pub(crate) fn small_mesh(dir: &Path, triangles: usize) -> PathBuf {
     let out = run_in(
         dir,
         &[
@@ -30,12 +30,12 @@ fn small_mesh(dir: &Path, triangles: usize) -> PathBuf {
     dir.join("small.msh")
 }
 
-fn stderr(out: &Output) -> String {
+pub(crate) fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 /// Arguments of a quick sweep on `mesh` into `out`.
-fn sweep_args(mesh: &Path, out: &str, runs: u32, horizons: &str) -> Vec<String> {
+pub(crate) fn sweep_args(mesh: &Path, out: &str, runs: u32, horizons: &str) -> Vec<String> {
     [
         "sweep",
         "--mesh",
@@ -60,20 +60,20 @@ fn sweep_args(mesh: &Path, out: &str, runs: u32, horizons: &str) -> Vec<String> 
     .collect()
 }
 
-fn sweep(dir: &Path, args: &[String], extra: &[&str]) -> Output {
+pub(crate) fn sweep(dir: &Path, args: &[String], extra: &[&str]) -> Output {
     let mut all: Vec<&str> = args.iter().map(String::as_str).collect();
     all.extend_from_slice(extra);
     run_in(dir, &all)
 }
 
-fn records(dir: &Path) -> Vec<RunRecord> {
+pub(crate) fn records(dir: &Path) -> Vec<RunRecord> {
     let mut r = store::read(&dir.join("runs.jsonl")).unwrap().records;
     r.sort_by_key(|r| r.key());
     r
 }
 
 /// Same runs with the same results (every field but the wall-clock time).
-fn assert_same(a: &[RunRecord], b: &[RunRecord], what: &str) {
+pub(crate) fn assert_same(a: &[RunRecord], b: &[RunRecord], what: &str) {
     assert_eq!(a.len(), b.len(), "{what}: record counts differ");
     for (x, y) in a.iter().zip(b) {
         assert!(x.same_result(y), "{what}: {x:?}\n  vs\n{y:?}");
@@ -150,7 +150,7 @@ fn threads_and_merged_shards_give_identical_records() {
 }
 
 /// Waits until `path` holds at least `lines` complete lines (or `limit` passes).
-fn wait_for_lines(path: &Path, lines: usize, limit: Duration) -> usize {
+pub(crate) fn wait_for_lines(path: &Path, lines: usize, limit: Duration) -> usize {
     let start = Instant::now();
     loop {
         let n = std::fs::read(path)
