@@ -545,11 +545,18 @@ fn no_tree_is_null_in_records_and_json() {
             "{f}: greedy's one-node trees"
         );
     }
-    // The committed records (old numbers) still read, as they are.
+    // The committed records hold null; records written before (0 for the optimum) still read,
+    // as they are.
     let committed = crate::util::repo_path("results/sphere/runs.jsonl");
-    let old = quadrecomb::internals::experiment::store::read(&committed)
+    let now = quadrecomb::internals::experiment::store::read(&committed)
         .unwrap()
         .records;
-    let opt = old.iter().find(|r| r.algo == "optimum").unwrap();
-    assert_eq!((opt.nodes_expanded, opt.trees), (Some(0), Some(0)));
+    let opt = now.iter().find(|r| r.algo == "optimum").unwrap();
+    assert_eq!((opt.nodes_expanded, opt.trees), (None, None));
+    let mut old: serde_json::Value = serde_json::to_value(opt).unwrap();
+    old["nodes_expanded"] = 0.into();
+    old["trees"] = 0.into();
+    let old: quadrecomb::internals::experiment::record::RunRecord =
+        serde_json::from_value(old).unwrap();
+    assert_eq!((old.nodes_expanded, old.trees), (Some(0), Some(0)));
 }
