@@ -105,7 +105,7 @@ fn replay_reproduces_every_record_on_the_cpu_twin() {
 }
 
 #[test]
-fn replay_reproduces_every_record_on_the_default_backend() {
+fn replay_reproduces_every_record_on_the_auto_backend() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = sweep(tmp.path(), "sphere", "auto", &[]);
     every_record_reproduces(tmp.path(), &dir);
