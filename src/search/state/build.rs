@@ -193,6 +193,7 @@ impl<'a> State<'a> {
             changed: Vec::new(),
             moved: Vec::new(),
             fan: Vec::new(),
+            shrunk: Vec::new(),
             searches: 0,
             searched: 0,
             split_shrinks: 0,

@@ -37,7 +37,10 @@ impl State<'_> {
         } else {
             NONE
         };
-        self.last_local_mask = r.mask;
+        // The clean vertices now (a kept verdict's mask can be older: a recheck that
+        // finds the same local verdict keeps it).
+        let ymask = self.clean_mask(c) & 0xF;
+        self.last_local_mask = ymask;
         if self.forward {
             // Nothing will be undone: the log only serves the trees.
             self.log.clear();
@@ -107,11 +110,25 @@ impl State<'_> {
                 }
             }
         }
+        // Split verdicts exact before this action, which had a local proof and lies inside
+        // one of their parts, are kept at once (`shrink_split`) instead of being marked:
+        // in lazy mode they would otherwise be searched again when next read.
+        let local = self.forward && r.kind == KIND_LOCAL;
+        self.shrunk.clear();
         for x in [t0, t1] {
             // Marking touches no watch list: iterate the list taken out, then put it back.
             let list = std::mem::take(&mut self.watch[x as usize]);
             for &(c2, ver) in &list {
                 if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
+                    if local && !self.cand[c2 as usize].dirty {
+                        if self.shrunk.contains(&c2) {
+                            continue;
+                        }
+                        if self.shrink_split(c2, c, ymask) {
+                            self.shrunk.push(c2);
+                            continue;
+                        }
+                    }
                     self.mark(c2);
                 }
             }
