@@ -194,6 +194,8 @@ impl<'a> State<'a> {
             moved: Vec::new(),
             fan: Vec::new(),
             shrunk: Vec::new(),
+            y_roots: Vec::new(),
+            attached: Vec::new(),
             searches: 0,
             searched: 0,
             split_shrinks: 0,

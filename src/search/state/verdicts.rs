@@ -14,7 +14,7 @@ impl State<'_> {
         let y = self.last_local;
         if y != NONE
             && self.chosen.last() == Some(&y)
-            && self.shrink_split(c, y, self.last_local_mask)
+            && self.shrink_split(c, y, self.last_local_mask, false)
         {
             return;
         }
@@ -90,7 +90,13 @@ impl State<'_> {
     /// along which its searches met gain those fans, through which they still meet
     /// (copied). Forward mode only (nothing to undo). A split verdict's certificate lists
     /// its finished parts first, `fin_known` triangles in all.
-    pub(super) fn shrink_split(&mut self, c: u32, y: u32, ymask: u8) -> bool {
+    ///
+    /// `distinct`: `y` was applied with the distinct-dead-components proof instead (its arcs'
+    /// components, before `y` joined them, in `y_roots`; this `apply`'s unions in
+    /// `attached`). Its pair must then lie in a finished part of `c`, no vertex shared, and
+    /// `c`'s quad must touch at most one of those components: without `c`'s pair, `y`'s
+    /// arcs are then still in distinct components and `y` cuts nothing of `c`'s part.
+    pub(super) fn shrink_split(&mut self, c: u32, y: u32, ymask: u8, distinct: bool) -> bool {
         if !self.forward {
             return false;
         }
@@ -99,18 +105,24 @@ impl State<'_> {
         if v.kind != KIND_SPLIT {
             return false;
         }
-        // The links at a vertex `c`'s quad shares with `y`'s pass through `c`'s triangles:
-        // only the other clean vertices count, and they must still join `y`'s remaining
-        // neighbours (`c`'s own triangles left out).
         let (qc, qy) = (self.cand[ci].quad, self.cand[y as usize].quad);
-        let mut ymask = ymask;
-        for (i, v) in qy.iter().enumerate() {
-            if qc.contains(v) {
-                ymask &= !(1 << i);
+        if distinct {
+            if qc.iter().any(|a| qy.contains(a)) || !self.distinct_without(c) {
+                return false;
             }
-        }
-        if !self.joined_without(y, ymask, self.cand[ci].pair) {
-            return false;
+        } else {
+            // The links at a vertex `c`'s quad shares with `y`'s pass through `c`'s
+            // triangles: only the other clean vertices count, and they must still join
+            // `y`'s remaining neighbours (`c`'s own triangles left out).
+            let mut ymask = ymask;
+            for (i, v) in qy.iter().enumerate() {
+                if qc.contains(v) {
+                    ymask &= !(1 << i);
+                }
+            }
+            if !self.joined_without(y, ymask, self.cand[ci].pair) {
+                return false;
+            }
         }
         let [a, b] = self.cand[y as usize].pair;
         let (off, fin, len) = (v.cert as usize, v.fin_known as usize, v.cert_len as usize);
@@ -138,7 +150,9 @@ impl State<'_> {
                 (new, len - 2, v.fin_known - 2)
             }
         } else {
-            if !cert[fin..].iter().any(|t| !keep(t)) || !self.fans(y, ymask) {
+            // The running part's paths through `y`'s pair are rerouted through the fans
+            // of a local proof; a distinct-components proof gives no such detour.
+            if distinct || !cert[fin..].iter().any(|t| !keep(t)) || !self.fans(y, ymask) {
                 return false;
             }
             let new = self.base_cert.len();
@@ -165,6 +179,27 @@ impl State<'_> {
         };
         self.cand[ci].verdict = kept;
         self.split_shrinks += 1;
+        true
+    }
+
+    /// Whether the quad of `c` touches at most one of the dead components in `y_roots`
+    /// (roots before this `apply`'s unions, which attached the roots in `attached`).
+    fn distinct_without(&self, c: u32) -> bool {
+        let mut hit = NONE;
+        for v in self.cand[c as usize].quad {
+            // The root before this apply: no path compression, so walk up to the first
+            // vertex that was a root then.
+            let mut r = v;
+            while self.dsu_parent[r as usize] != r && !self.attached.contains(&r) {
+                r = self.dsu_parent[r as usize];
+            }
+            if self.y_roots.contains(&r) {
+                if hit != NONE && hit != r {
+                    return false;
+                }
+                hit = r;
+            }
+        }
         true
     }
 
