@@ -560,3 +560,30 @@ fn no_tree_is_null_in_records_and_json() {
         serde_json::from_value(old).unwrap();
     assert_eq!((old.nodes_expanded, old.trees), (Some(0), Some(0)));
 }
+
+/// `bench search --mesh` (#27 item 11) compares greedy with selective h = 1 on the meshes
+/// named, after `borouchaki`, and `--greedy-only` stops there; a mesh that cannot be read
+/// is bad input named before any timing.
+#[test]
+fn bench_search_compares_greedy_on_named_meshes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let args = ["bench", "search", "--greedy-only", "--runs", "1"];
+    let o = run_in(tmp.path(), &[&args[..], &["--mesh", "sphere"]].concat());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let rows: Vec<&str> = out.lines().filter(|l| l.starts_with("| ")).collect();
+    assert_eq!(rows.len(), 3, "header, borouchaki and sphere only: {out}");
+    assert!(rows[1].starts_with("| borouchaki | 34456 |"), "{out}");
+    assert!(rows[2].starts_with("| sphere |"), "{out}");
+    // Ratio and work columns are numbers.
+    let cells: Vec<&str> = rows[2].split('|').map(str::trim).collect();
+    assert!(cells[6].parse::<f64>().unwrap() > 0.0, "{out}");
+    assert!(cells[7].contains(" / "), "{out}");
+    let o = run_in(
+        tmp.path(),
+        &[&args[..], &["--mesh", "missing.msh"]].concat(),
+    );
+    assert!(o.stdout.is_empty(), "nothing timed");
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(stderr(&o).contains("missing.msh"), "{}", stderr(&o));
+}

@@ -23,6 +23,14 @@ pub struct Args {
     /// into a maze where most actions split a polder).
     #[arg(long, default_value_t = 2)]
     max_uniform: u32,
+    /// Also compare greedy with selective h = 1 on this mesh (a .msh file or a built-in
+    /// name; repeatable): the meshes on which greedy leaves many triangles, such as Gmsh
+    /// Delaunay meshes of a square with holes, are where its criterion searched longest.
+    #[arg(long = "mesh", value_name = "MESH")]
+    meshes: Vec<String>,
+    /// Only the greedy / selective h = 1 comparison (`borouchaki` and the --mesh meshes).
+    #[arg(long)]
+    greedy_only: bool,
     #[command(flatten)]
     rule: crate::cli::RuleArgs,
 }
@@ -42,6 +50,9 @@ const FIRST_GRID: usize = 10_000;
 /// Rounds of the grid rows.
 const GRID_ROUNDS: usize = 3;
 
+/// Rounds of the greedy / selective h = 1 comparison (alternating the two).
+const RATIO_ROUNDS: usize = 5;
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -60,6 +71,8 @@ struct Row {
     nodes_per_triangle: f64,
     /// Median per run of the triangles the criterion's searches visited, per triangle.
     searched_per_triangle: f64,
+    /// Median per run of the criterion's checks that needed a search, per triangle.
+    searches_per_triangle: f64,
 }
 
 /// Runs `algo` with seeds `0..runs` and summarises the medians.
@@ -72,12 +85,14 @@ fn measure(
     runs: u64,
 ) -> Row {
     let (mut wall, mut cpu, mut q, mut rec, mut bf) = (vec![], vec![], vec![], vec![], vec![]);
-    let (mut nodes, mut searched) = (vec![], vec![]);
+    let (mut nodes, mut searched, mut searches) = (vec![], vec![], vec![]);
     for seed in 0..runs {
         let c0 = thread_cpu_s();
-        let w0 = searcher.criterion_work().1;
+        let w0 = searcher.criterion_work();
         let out = searcher.run(algo, seed);
-        searched.push((searcher.criterion_work().1 - w0) as f64 / triangles as f64);
+        let w1 = searcher.criterion_work();
+        searched.push((w1.1 - w0.1) as f64 / triangles as f64);
+        searches.push((w1.0 - w0.0) as f64 / triangles as f64);
         nodes.push(out.nodes_expanded as f64 / triangles as f64);
         if let (Some(a), Some(b)) = (c0, thread_cpu_s()) {
             cpu.push((b - a) * 1e3);
@@ -102,7 +117,41 @@ fn measure(
         nodes_per_decision: median(bf),
         nodes_per_triangle: median(nodes),
         searched_per_triangle: median(searched),
+        searches_per_triangle: median(searches),
     }
+}
+
+/// Greedy against selective h = 1 on one mesh, alternately over [`RATIO_ROUNDS`] rounds
+/// (this VM's speed drifts): the medians of each round's runs, the median of the rounds'
+/// ratios, and the criterion's work per triangle.
+fn greedy_row(name: &str, m: &mesh::Mesh, t: &CandidateTable, runs: u64) {
+    let mut s = Searcher::new(m, t);
+    let nt = m.num_triangles();
+    let sel = Algo::Selective { horizon: 1 };
+    let (mut g, mut h, mut ratio) = (vec![], vec![], vec![]);
+    let mut last = None;
+    for _ in 0..RATIO_ROUNDS {
+        let a = measure(&mut s, name, nt, None, Algo::Greedy, runs);
+        let b = measure(&mut s, name, nt, None, sel, runs);
+        g.push(a.wall_ms);
+        h.push(b.wall_ms);
+        ratio.push(a.wall_ms / b.wall_ms);
+        last = Some((a, b));
+    }
+    let (a, b) = last.expect("at least one round");
+    let left = |r: &Row| (nt as f64 * (1.0 - r.recombined_pct / 100.0)).round();
+    println!(
+        "| {name} | {nt} | {} / {} | {:.1} | {:.1} | {:.2} | {:.3} / {:.1} | {:.3} / {:.1} |",
+        left(&a),
+        left(&b),
+        median(g),
+        median(h),
+        median(ratio),
+        a.searches_per_triangle,
+        a.searched_per_triangle,
+        b.searches_per_triangle,
+        b.searched_per_triangle,
+    );
 }
 
 fn print_row(r: &Row) {
@@ -127,6 +176,33 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .into());
     }
     let rule = args.rule.rule()?;
+    let mut named = vec!["borouchaki".to_string()];
+    named.extend(args.meshes.iter().cloned());
+    let mut compared = Vec::new();
+    for name in &named {
+        // Loaded before any timing: a bad file fails at once.
+        compared.push((name, mesh::load(name)?));
+    }
+    println!(
+        "Greedy against selective h=1, {RATIO_ROUNDS} rounds alternating them, {} seeds each \
+         (greedy is deterministic): triangles left, median wall ms, the median of the rounds' \
+         ratios greedy / selective, and the criterion's work per triangle (checks that needed \
+         a search / triangles they visited). Rule: {rule}.\n",
+        args.runs
+    );
+    println!(
+        "| mesh | triangles | left, greedy / selective | greedy ms | selective h=1 ms | ratio \
+         | greedy searches / searched | selective searches / searched |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    for (name, m) in &compared {
+        let t = CandidateTable::build(m).restrict(m, rule);
+        greedy_row(name, m, &t, args.runs);
+    }
+    println!();
+    if args.greedy_only {
+        return Ok(ExitCode::SUCCESS);
+    }
     println!(
         "Per run (median over seeds 0..{}): wall and thread-CPU milliseconds, quality as % of \
          the exact optimum, % of triangles recombined, nodes expanded per decision. Rule: {rule}.\n",

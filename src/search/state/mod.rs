@@ -291,6 +291,12 @@ pub struct State<'a> {
     moved: Vec<u32>,
     /// Fan triangles for [`State::shrink_split`].
     fan: Vec<u32>,
+    /// Candidates whose split verdict the current `apply` kept by `shrink_split`.
+    shrunk: Vec<u32>,
+    /// The dead components an action's distinct-components proof saw (roots before its
+    /// unions), and the roots its unions attached: for `shrink_split`.
+    y_roots: Vec<u32>,
+    attached: Vec<u32>,
     /// Number of criterion checks that needed a search (statistics).
     pub searches: u64,
     /// Number of triangles those searches visited.

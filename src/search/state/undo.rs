@@ -2,7 +2,7 @@
 //! every change as an [`Op`], `undo` reverts the last action in O(1) per change, `reset`
 //! returns to the initial state.
 
-use super::{DEAD, Initial, KIND_LOCAL, Op, State, is_split};
+use super::{DEAD, Initial, KIND_DISTINCT, KIND_LOCAL, Op, State, is_split};
 use crate::mesh::NONE;
 
 impl State<'_> {
@@ -26,18 +26,32 @@ impl State<'_> {
         // parts are relabelled).
         let v = self.cand[ci].verdict;
         let exact_before = self.dirty_list.is_empty();
-        let r = if !self.cand[ci].dirty && v.allowed && !is_split(v.kind) {
-            v
-        } else {
-            self.check(c)
-        };
+        let kept = !self.cand[ci].dirty && v.allowed && !is_split(v.kind);
+        let r = if kept { v } else { self.check(c) };
         let split = is_split(r.kind);
         self.last_local = if exact_before && r.kind == KIND_LOCAL {
             c
         } else {
             NONE
         };
-        self.last_local_mask = r.mask;
+        // The clean vertices now (a kept verdict's mask can be older: a recheck that
+        // finds the same local verdict keeps it).
+        let ymask = self.clean_mask(c) & 0xF;
+        self.last_local_mask = ymask;
+        // A distinct-components proof: its arcs' components before the unions below.
+        let distinct = self.forward && r.kind == KIND_DISTINCT;
+        self.y_roots.clear();
+        if distinct {
+            if kept {
+                let cert = &self.base_cert[r.cert as usize..(r.cert + r.cert_len) as usize];
+                self.y_roots.extend_from_slice(cert);
+            } else {
+                // Just checked: the roots are in scratch.
+                self.y_roots
+                    .extend_from_slice(&self.arc_roots[..self.narcs]);
+            }
+        }
+        self.attached.clear();
         if self.forward {
             // Nothing will be undone: the log only serves the trees.
             self.log.clear();
@@ -90,6 +104,7 @@ impl State<'_> {
         let qv = self.cand[ci].quad;
         for i in 1..4 {
             if let Some(child) = self.union(qv[0], qv[i]) {
+                self.attached.push(child);
                 for j in 0..self.root_watch[child as usize].len() {
                     let (c2, ver) = self.root_watch[child as usize][j];
                     if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
@@ -107,11 +122,25 @@ impl State<'_> {
                 }
             }
         }
+        // Split verdicts exact before this action, which had a local proof and lies inside
+        // one of their parts, are kept at once (`shrink_split`) instead of being marked:
+        // in lazy mode they would otherwise be searched again when next read.
+        let local = self.forward && r.kind == KIND_LOCAL;
+        self.shrunk.clear();
         for x in [t0, t1] {
             // Marking touches no watch list: iterate the list taken out, then put it back.
             let list = std::mem::take(&mut self.watch[x as usize]);
             for &(c2, ver) in &list {
                 if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
+                    if (local || distinct) && !self.cand[c2 as usize].dirty {
+                        if self.shrunk.contains(&c2) {
+                            continue;
+                        }
+                        if self.shrink_split(c2, c, ymask, distinct) {
+                            self.shrunk.push(c2);
+                            continue;
+                        }
+                    }
                     self.mark(c2);
                 }
             }

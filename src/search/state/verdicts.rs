@@ -11,7 +11,11 @@ impl State<'_> {
         if self.forward && self.base_cert.len() >= self.base_cert_compact_at {
             self.compact_base_cert();
         }
-        if self.shrink_split(c) {
+        let y = self.last_local;
+        if y != NONE
+            && self.chosen.last() == Some(&y)
+            && self.shrink_split(c, y, self.last_local_mask, false)
+        {
             return;
         }
         let r = self.check(c);
@@ -86,9 +90,14 @@ impl State<'_> {
     /// along which its searches met gain those fans, through which they still meet
     /// (copied). Forward mode only (nothing to undo). A split verdict's certificate lists
     /// its finished parts first, `fin_known` triangles in all.
-    fn shrink_split(&mut self, c: u32) -> bool {
-        let y = self.last_local;
-        if y == NONE || !self.forward || self.chosen.last() != Some(&y) {
+    ///
+    /// `distinct`: `y` was applied with the distinct-dead-components proof instead (its arcs'
+    /// components, before `y` joined them, in `y_roots`; this `apply`'s unions in
+    /// `attached`). Its pair must then lie in a finished part of `c`, no vertex shared, and
+    /// `c`'s quad must touch at most one of those components: without `c`'s pair, `y`'s
+    /// arcs are then still in distinct components and `y` cuts nothing of `c`'s part.
+    pub(super) fn shrink_split(&mut self, c: u32, y: u32, ymask: u8, distinct: bool) -> bool {
+        if !self.forward {
             return false;
         }
         let ci = c as usize;
@@ -97,8 +106,23 @@ impl State<'_> {
             return false;
         }
         let (qc, qy) = (self.cand[ci].quad, self.cand[y as usize].quad);
-        if qc.iter().any(|a| qy.contains(a)) {
-            return false;
+        if distinct {
+            if qc.iter().any(|a| qy.contains(a)) || !self.distinct_without(c) {
+                return false;
+            }
+        } else {
+            // The links at a vertex `c`'s quad shares with `y`'s pass through `c`'s
+            // triangles: only the other clean vertices count, and they must still join
+            // `y`'s remaining neighbours (`c`'s own triangles left out).
+            let mut ymask = ymask;
+            for (i, v) in qy.iter().enumerate() {
+                if qc.contains(v) {
+                    ymask &= !(1 << i);
+                }
+            }
+            if !self.joined_without(y, ymask, self.cand[ci].pair) {
+                return false;
+            }
         }
         let [a, b] = self.cand[y as usize].pair;
         let (off, fin, len) = (v.cert as usize, v.fin_known as usize, v.cert_len as usize);
@@ -126,7 +150,9 @@ impl State<'_> {
                 (new, len - 2, v.fin_known - 2)
             }
         } else {
-            if !cert[fin..].iter().any(|t| !keep(t)) || !self.fans(y, self.last_local_mask) {
+            // The running part's paths through `y`'s pair are rerouted through the fans
+            // of a local proof; a distinct-components proof gives no such detour.
+            if distinct || !cert[fin..].iter().any(|t| !keep(t)) || !self.fans(y, ymask) {
                 return false;
             }
             let new = self.base_cert.len();
@@ -154,6 +180,63 @@ impl State<'_> {
         self.cand[ci].verdict = kept;
         self.split_shrinks += 1;
         true
+    }
+
+    /// Whether the quad of `c` touches at most one of the dead components in `y_roots`
+    /// (roots before this `apply`'s unions, which attached the roots in `attached`).
+    fn distinct_without(&self, c: u32) -> bool {
+        let mut hit = NONE;
+        for v in self.cand[c as usize].quad {
+            // The root before this apply: no path compression, so walk up to the first
+            // vertex that was a root then.
+            let mut r = v;
+            while self.dsu_parent[r as usize] != r && !self.attached.contains(&r) {
+                r = self.dsu_parent[r as usize];
+            }
+            if self.y_roots.contains(&r) {
+                if hit != NONE && hit != r {
+                    return false;
+                }
+                hit = r;
+            }
+        }
+        true
+    }
+
+    /// Whether the remaining neighbours of candidate `y`'s quad, the triangles `skip`
+    /// left out, form one group when joined at the quad vertices `mask` (neighbours `i - 1`
+    /// and `i` at vertex `i`, as in [`State::check_slow`]) and where a neighbour is the
+    /// same triangle across two sides.
+    fn joined_without(&self, y: u32, mask: u8, skip: [u32; 2]) -> bool {
+        let n = self.cand[y as usize].nb;
+        let live = n.map(|t| t != NONE && self.alive[t as usize] && !skip.contains(&t));
+        let mut root = [0u8, 1, 2, 3];
+        let join = |r: &mut [u8; 4], a: usize, b: usize| {
+            let (x, z) = (r[a], r[b]);
+            for k in r.iter_mut() {
+                if *k == z {
+                    *k = x;
+                }
+            }
+        };
+        for i in 0..4 {
+            if !live[i] {
+                continue;
+            }
+            for j in 0..i {
+                if live[j] && n[i] == n[j] {
+                    join(&mut root, i, j);
+                }
+            }
+            let j = (i + 1) % 4;
+            if live[j] && mask & (1 << j) != 0 {
+                join(&mut root, i, j);
+            }
+        }
+        let mut first = None;
+        (0..4)
+            .filter(|&i| live[i])
+            .all(|i| *first.get_or_insert(root[i]) == root[i])
     }
 
     /// The triangles around the clean quad vertices `mask` of candidate `y` (both of its
