@@ -39,7 +39,7 @@ enum Command {
     Optimum(optimum::Args),
     /// Run a seeded horizon sweep (the paper's experiment) into a results directory.
     Sweep(sweep::Args),
-    /// Merge sharded sweep results into one directory.
+    /// Merge sharded sweep results (or a sweep and its extension) into one directory.
     Merge(merge::Args),
     /// Write tables, figures and statistical comparisons for a results directory.
     Report(report::Args),
