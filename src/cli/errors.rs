@@ -17,7 +17,7 @@ use quadrecomb::internals::experiment::ExperimentError;
 use quadrecomb::internals::gpu::GpuError;
 use quadrecomb::internals::report::ReportError;
 
-use super::BadInput;
+use super::UsageError;
 
 /// Any other failure.
 pub const EXIT_FAILURE: u8 = 1;
@@ -76,7 +76,7 @@ pub fn check_results_dir(dir: &std::path::Path) -> anyhow::Result<()> {
 
 /// The code one cause decides, if it decides one.
 fn code(e: &(dyn Error + 'static)) -> Option<u8> {
-    if e.is::<BadInput>() {
+    if e.is::<UsageError>() {
         return Some(EXIT_USAGE);
     }
     if e.is::<super::InputError>() {
@@ -223,7 +223,7 @@ mod tests {
         );
         let report = ReportError::Results(ExperimentError::AlreadyExists { dir, records: 1 });
         assert_eq!(exit_code(&report.into()), EXIT_RESULTS_DIR);
-        assert_eq!(exit_code(&BadInput("x".into()).into()), EXIT_USAGE);
+        assert_eq!(exit_code(&UsageError("x".into()).into()), EXIT_USAGE);
     }
 
     #[test]

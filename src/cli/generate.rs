@@ -1,7 +1,7 @@
 //! `quadrecomb generate`: procedural meshes of any size (jittered grid, icosphere, and
 //! one-cell-wide strip, spiral and maze), written as MSH 4.1 ASCII.
 
-use super::BadInput;
+use super::UsageError;
 use quadrecomb::internals::mesh::Recombined;
 use quadrecomb::internals::mesh::generate::{self, Corridor, GridSpec, MAX_SUBDIVISIONS};
 use std::path::{Path, PathBuf};
@@ -101,7 +101,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 surfaces: a.surfaces,
                 drop_triangles: a.drop_triangles,
             };
-            spec.validate().map_err(|e| BadInput(e.to_string()))?;
+            spec.validate().map_err(|e| UsageError(e.to_string()))?;
             check_memory(a.triangles)?;
             check_output(&a.output)?;
             let (nx, ny) = spec.cells();
@@ -112,7 +112,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             let s = match (a.subdivisions, a.triangles) {
                 (Some(s), _) => s,
                 (None, Some(0)) => {
-                    return Err(BadInput(
+                    return Err(UsageError(
                         "--triangles 0: an icosphere has at least 20 triangles (0 \
                          subdivisions); give a target of 1 or more, or --subdivisions"
                             .into(),
@@ -122,7 +122,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 (None, Some(n)) => {
                     let largest = 20usize << (2 * MAX_SUBDIVISIONS);
                     if n > 2 * largest {
-                        return Err(BadInput(format!(
+                        return Err(UsageError(format!(
                             "--triangles {n}: the largest icosphere has {largest} triangles \
                              ({MAX_SUBDIVISIONS} subdivisions)"
                         ))
@@ -133,7 +133,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 (None, None) => unreachable!("clap requires one of them"),
             };
             if s > MAX_SUBDIVISIONS {
-                return Err(BadInput(format!(
+                return Err(UsageError(format!(
                     "--subdivisions must be at most {MAX_SUBDIVISIONS} (got {s})"
                 ))
                 .into());
@@ -185,7 +185,7 @@ const BYTES_PER_TRIANGLE: u64 = 200;
 
 /// Refuses, before allocating, a grid that needs more memory than the machine has (it
 /// aborted allocating instead).
-fn check_memory(triangles: usize) -> Result<(), BadInput> {
+fn check_memory(triangles: usize) -> Result<(), UsageError> {
     let Some(total) = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
         s.lines()
             .find_map(|l| l.strip_prefix("MemTotal:"))
@@ -197,7 +197,7 @@ fn check_memory(triangles: usize) -> Result<(), BadInput> {
     let need = (triangles as u64).saturating_mul(BYTES_PER_TRIANGLE);
     if need > total {
         let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
-        return Err(BadInput(format!(
+        return Err(UsageError(format!(
             "--triangles {triangles}: generating needs about {:.1} GiB of memory (about \
              {BYTES_PER_TRIANGLE} bytes per triangle), more than this machine's {:.1} GiB; \
              at most about {} triangles here",
@@ -214,7 +214,7 @@ fn corridor(
     shape: Corridor,
     a: CorridorArgs,
 ) -> anyhow::Result<(quadrecomb::internals::mesh::Mesh, String, PathBuf)> {
-    generate::validate_corridor(shape, a.triangles).map_err(|e| BadInput(e.to_string()))?;
+    generate::validate_corridor(shape, a.triangles).map_err(|e| UsageError(e.to_string()))?;
     check_output(&a.output)?;
     let what = format!("{}, seed {}", shape.name(), a.seed);
     Ok((
@@ -225,12 +225,12 @@ fn corridor(
 }
 
 /// Fails early (before generating) if the output cannot be a new .msh file.
-fn check_output(path: &Path) -> Result<(), BadInput> {
+fn check_output(path: &Path) -> Result<(), UsageError> {
     if path
         .extension()
         .is_none_or(|e| !e.eq_ignore_ascii_case("msh"))
     {
-        return Err(BadInput(format!(
+        return Err(UsageError(format!(
             "{}: the output must be a .msh file",
             path.display()
         )));

@@ -88,9 +88,9 @@ pub struct RuleArgs {
 
 impl RuleArgs {
     /// The rule, or a usage error naming the flag.
-    pub fn rule(&self) -> Result<quadrecomb::internals::quality::Rule, BadInput> {
+    pub fn rule(&self) -> Result<quadrecomb::internals::quality::Rule, UsageError> {
         quadrecomb::internals::quality::Rule::new(self.min_eta, self.allow_invalid)
-            .map_err(|e| BadInput(format!("--min-eta: {e}")))
+            .map_err(|e| UsageError(format!("--min-eta: {e}")))
     }
 }
 
@@ -140,7 +140,7 @@ pub struct MeshOutputArgs {
 /// exit code 2 ([`errors::EXIT_USAGE`]).
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
-pub struct BadInput(pub String);
+pub struct UsageError(pub String);
 
 /// An input file the command was pointed at that it cannot use (a results directory without
 /// records, a mesh that changed since the sweep), worded by the CLI: exit code 3
@@ -151,9 +151,9 @@ pub struct InputError(pub String);
 
 /// Checks before any work that an output path names a `.msh` or `.vtu` file (any case) in
 /// a directory that exists, so that a long run does not end on a path it cannot write.
-pub fn check_mesh_output(path: Option<&std::path::Path>) -> Result<(), BadInput> {
+pub fn check_mesh_output(path: Option<&std::path::Path>) -> Result<(), UsageError> {
     match path {
-        Some(p) if output_kind(p).is_none() => Err(BadInput(format!(
+        Some(p) if output_kind(p).is_none() => Err(UsageError(format!(
             "output {}: expected a .msh or .vtu file name",
             p.display()
         ))),
@@ -165,8 +165,8 @@ pub fn check_mesh_output(path: Option<&std::path::Path>) -> Result<(), BadInput>
 /// The part of [`check_mesh_output`] that does not look at the extension: `path` names a
 /// file (not a directory, no trailing slash) in a directory that exists and takes a new file
 /// (tried by creating and removing a temporary one, as the atomic writer will).
-pub fn check_output_place(p: &std::path::Path) -> Result<(), BadInput> {
-    let bad = |why: String| Err(BadInput(format!("output {}: {why}", p.display())));
+pub fn check_output_place(p: &std::path::Path) -> Result<(), UsageError> {
+    let bad = |why: String| Err(UsageError(format!("output {}: {why}", p.display())));
     if p.is_dir() || p.as_os_str().to_string_lossy().ends_with('/') {
         return bad("names a directory, not a file".into());
     }
@@ -193,7 +193,7 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), BadInput> {
 /// Refuses an output that is the input mesh file itself, however it is spelled (`./in.msh`,
 /// a symbolic or hard link): the same file by device and inode. Writing it would destroy the
 /// input.
-pub fn check_not_input(output: Option<&std::path::Path>, input: &str) -> Result<(), BadInput> {
+pub fn check_not_input(output: Option<&std::path::Path>, input: &str) -> Result<(), UsageError> {
     let Some(out) = output else {
         return Ok(());
     };
@@ -208,7 +208,7 @@ pub fn check_not_input(output: Option<&std::path::Path>, input: &str) -> Result<
     #[cfg(not(unix))]
     let same = std::fs::canonicalize(out).ok() == std::fs::canonicalize(input).ok();
     if same {
-        return Err(BadInput(format!(
+        return Err(UsageError(format!(
             "output {} is the input mesh {input}: refusing to overwrite the input; choose \
              another -o",
             out.display()
@@ -237,7 +237,7 @@ pub fn write_mesh_output(
     mesh: &quadrecomb::internals::mesh::Mesh,
     rec: &quadrecomb::internals::mesh::Recombined,
     vtu_ascii: bool,
-) -> Result<(), BadInput> {
+) -> Result<(), UsageError> {
     use quadrecomb::internals::mesh::vtu::Encoding;
     let vtu = output_kind(path) == Some(true);
     let encoding = if vtu_ascii {
@@ -253,7 +253,7 @@ pub fn write_mesh_output(
         }
     })
     .map_err(|e| {
-        BadInput(format!(
+        UsageError(format!(
             "cannot write output {} (through a temporary file beside it): {e}",
             path.display()
         ))

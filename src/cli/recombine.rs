@@ -1,6 +1,6 @@
 //! `quadrecomb recombine`: one run of one policy on one mesh.
 
-use super::BadInput;
+use super::UsageError;
 use quadrecomb::internals::experiment::replay::{self, EtaSource};
 use quadrecomb::internals::quality::{self, CandidateTable, ElementQuality, Rule};
 use quadrecomb::internals::search::{self, Algo, optimum};
@@ -93,7 +93,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         AlgoName::Selective => "selective",
     };
     let algo =
-        Algo::from_name(name, args.horizon.unwrap_or(1)).map_err(|e| BadInput(e.to_string()))?;
+        Algo::from_name(name, args.horizon.unwrap_or(1)).map_err(|e| UsageError(e.to_string()))?;
     if args.horizon.is_some() && matches!(algo, Algo::GreedyNocrit | Algo::Greedy) {
         eprintln!("note: --horizon is ignored: {name} looks no further than one action");
     }

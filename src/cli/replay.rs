@@ -2,7 +2,7 @@
 //! eta and rule (through [`quadrecomb::internals::experiment::replay`], as the report's pictures), checked
 //! against its record, and optionally written as `.msh` / `.vtu`.
 
-use super::BadInput;
+use super::UsageError;
 use quadrecomb::internals::experiment::replay::{self, EtaCheck, Replayer};
 use quadrecomb::internals::report::{Config, Results, Run};
 use std::path::PathBuf;
@@ -39,12 +39,12 @@ enum Which {
     Typical,
 }
 
-fn parse_run(s: &str) -> Result<Which, BadInput> {
+fn parse_run(s: &str) -> Result<Which, UsageError> {
     if s == "typical" {
         return Ok(Which::Typical);
     }
     s.parse().map(Which::Index).map_err(|_| {
-        BadInput(format!(
+        UsageError(format!(
             "bad RUN {s:?}: expected a run index (the records' `run` field, e.g. 0) or `typical`"
         ))
     })
@@ -54,7 +54,7 @@ fn parse_run(s: &str) -> Result<Which, BadInput> {
 fn choose_config<'r>(
     results: &'r Results,
     args: &Args,
-) -> Result<(&'r Config, &'r [Run]), BadInput> {
+) -> Result<(&'r Config, &'r [Run]), UsageError> {
     let found = results.groups.iter().find(|(c, _)| {
         args.mesh.as_ref().is_none_or(|m| *m == c.mesh)
             && args.algo.as_ref().is_none_or(|a| *a == c.algo)
@@ -70,7 +70,7 @@ fn choose_config<'r>(
     let held: Vec<String> = (results.groups.keys())
         .map(|c| format!("{} {}", c.mesh, c.label()))
         .collect();
-    Err(BadInput(format!(
+    Err(UsageError(format!(
         "{}: no configuration with {} (it holds: {})",
         args.dir.display(),
         asked.join(", "),
@@ -109,7 +109,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Which::Index(i) => runs.iter().find(|r| r.run == i),
     };
     let Some(record) = record else {
-        return Err(BadInput(format!(
+        return Err(UsageError(format!(
             "{}: {} {} has no run {} (recorded runs: {})",
             args.dir.display(),
             config.mesh,

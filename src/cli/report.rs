@@ -1,6 +1,6 @@
 //! `quadrecomb report DIR [--compare DIR2] [--zoom x0,y0,x1,y1]`.
 
-use super::BadInput;
+use super::UsageError;
 use quadrecomb::internals::report::{self, ReportOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -42,9 +42,9 @@ pub fn paths_json(paths: &report::ReportPaths) -> serde_json::Value {
 }
 
 /// Parses "x0,y0,x1,y1" into a window with x0 < x1 and y0 < y1.
-fn parse_zoom(s: &str) -> Result<[f64; 4], BadInput> {
+fn parse_zoom(s: &str) -> Result<[f64; 4], UsageError> {
     let bad = || {
-        BadInput(format!(
+        UsageError(format!(
             "bad --zoom {s:?}: expected x0,y0,x1,y1 with x0 < x1 and y0 < y1, e.g. 0.6,0.6,1,1"
         ))
     };
@@ -62,14 +62,14 @@ fn parse_zoom(s: &str) -> Result<[f64; 4], BadInput> {
 }
 
 /// Parses "algo" or "algo:h".
-fn parse_picture(s: &str) -> Result<(String, Option<u32>), BadInput> {
+fn parse_picture(s: &str) -> Result<(String, Option<u32>), UsageError> {
     match s.split_once(':') {
         None => Ok((s.to_string(), None)),
         Some((a, h)) => h
             .parse::<u32>()
             .map(|h| (a.to_string(), Some(h)))
             .map_err(|_| {
-                BadInput(format!(
+                UsageError(format!(
                     "bad --picture {s:?}: expected ALGO or ALGO:H, e.g. selective:5"
                 ))
             }),

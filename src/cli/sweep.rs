@@ -12,7 +12,7 @@ use quadrecomb::internals::experiment::manifest::Shard;
 use quadrecomb::internals::experiment::sweep;
 use quadrecomb::internals::gpu::Backend;
 
-use super::BadInput;
+use super::UsageError;
 use super::errors::EXIT_INTERRUPTED;
 use super::sweep_progress::{ProgressMode, SweepDisplay};
 
@@ -310,8 +310,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 }
 
 /// A configuration error worded with the flags that set the values it names.
-fn config_error(e: ConfigError) -> BadInput {
-    BadInput(match e {
+fn config_error(e: ConfigError) -> UsageError {
+    UsageError(match e {
         ConfigError::ZeroRuns => "--runs must be at least 1".into(),
         ConfigError::SeedTooLarge(seed) => format!(
             "--seed {seed} is above 2^53 - 1 = {}: records hold it as a JSON number, which jq \

@@ -1,6 +1,6 @@
 //! `quadrecomb bench io`: parse, topology and candidate-table times (median of repetitions).
 
-use crate::cli::BadInput;
+use crate::cli::UsageError;
 use quadrecomb::internals::mesh::{self, Mesh};
 use quadrecomb::internals::quality::CandidateTable;
 use std::process::ExitCode;
@@ -30,11 +30,11 @@ fn median_ms(reps: usize, mut f: impl FnMut()) -> f64 {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.reps == 0 {
-        return Err(BadInput("--reps must be at least 1".into()).into());
+        return Err(UsageError("--reps must be at least 1".into()).into());
     }
     let meshes = if args.meshes.is_empty() {
         if mesh::builtin::bytes("borouchaki").is_none() {
-            return Err(BadInput(
+            return Err(UsageError(
                 "no built-in `borouchaki` in this build: give mesh files to benchmark".into(),
             )
             .into());

@@ -9,7 +9,7 @@
 //! * independent: addresses from a generator that reads no memory, so the core overlaps
 //!   the misses (what prefetching or batching could at best reach).
 
-use crate::cli::BadInput;
+use crate::cli::UsageError;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
@@ -68,10 +68,10 @@ fn independent_ns(data: &[u64], loads: usize) -> f64 {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.max_mib == 0 {
-        return Err(BadInput("--max-mib must be at least 1".into()).into());
+        return Err(UsageError("--max-mib must be at least 1".into()).into());
     }
     if args.loads == 0 {
-        return Err(BadInput("--loads must be at least 1".into()).into());
+        return Err(UsageError("--loads must be at least 1".into()).into());
     }
     println!(
         "random loads of 8 bytes, {} per size and kind (ns per load; lower is faster)",
@@ -88,7 +88,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .checked_mul(1 << 17)
             .and_then(|n| random_cycle(n, &mut rng))
         else {
-            return Err(BadInput(format!(
+            return Err(UsageError(format!(
                 "cannot allocate {mib} MiB for the working set: lower --max-mib"
             ))
             .into());

@@ -1,7 +1,7 @@
 //! `quadrecomb bench optimum`: time of the exact optimum on the built-in meshes and on
 //! generated jittered grids of growing size, with the fitted growth exponent and peak memory.
 
-use crate::cli::BadInput;
+use crate::cli::UsageError;
 use quadrecomb::internals::mesh::generate::{self, GridSpec, MAX_GRID_TRIANGLES};
 use quadrecomb::internals::mesh::{Mesh, MeshData};
 use quadrecomb::internals::quality::CandidateTable;
@@ -41,12 +41,12 @@ pub const MIN_SIZE: usize = 100;
 
 /// Refuses, before any work, sizes outside [`MIN_SIZE`, [`MAX_GRID_TRIANGLES`]] (0 panicked,
 /// 1 and 2 timed a 2-triangle mesh), naming the flag and the limit.
-fn check_sizes(flag: &str, sizes: &[usize]) -> Result<(), BadInput> {
+fn check_sizes(flag: &str, sizes: &[usize]) -> Result<(), UsageError> {
     match sizes
         .iter()
         .find(|&&n| !(MIN_SIZE..=MAX_GRID_TRIANGLES).contains(&n))
     {
-        Some(n) => Err(BadInput(format!(
+        Some(n) => Err(UsageError(format!(
             "{flag} {n}: sizes must be between {MIN_SIZE} triangles (below that the time is the \
              timer's and the set-up's, not the matching's) and {MAX_GRID_TRIANGLES}"
         ))),

@@ -4,7 +4,7 @@
 //! figure for the child (`ru_maxrss` of `wait4`), loading and the candidate table included.
 //! A child that fails (out of memory under a limit, say) is reported with its exit status.
 
-use crate::cli::BadInput;
+use crate::cli::UsageError;
 use quadrecomb::internals::mesh::Recombined;
 use quadrecomb::internals::mesh::generate::{self, Corridor, GridSpec};
 use std::path::{Path, PathBuf};
@@ -99,7 +99,7 @@ fn build(shape: &str, n: usize) -> quadrecomb::internals::mesh::Mesh {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for s in &args.shapes {
         if !["grid", "strip", "spiral", "maze"].contains(&s.as_str()) {
-            return Err(BadInput(format!(
+            return Err(UsageError(format!(
                 "--shapes: unknown shape `{s}` (grid, strip, spiral, maze)"
             ))
             .into());
@@ -107,10 +107,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     for a in &args.algos {
         quadrecomb::internals::search::Algo::from_name(a, args.horizon.max(1))
-            .map_err(|e| BadInput(format!("--algos: {e}")))?;
+            .map_err(|e| UsageError(format!("--algos: {e}")))?;
     }
     if args.max_triangles < 10_000 {
-        return Err(BadInput("--max-triangles must be at least 10000".into()).into());
+        return Err(UsageError("--max-triangles must be at least 10000".into()).into());
     }
     let exe = std::env::current_exe()?;
     let dir = tempfile_dir()?;

@@ -1,7 +1,7 @@
 //! `quadrecomb bench search`: time per run of every policy on the built-in meshes, and time
 //! per triangle of the selective tree on generated grids of growing size.
 
-use crate::cli::BadInput;
+use crate::cli::UsageError;
 use quadrecomb::internals::mesh::{
     self,
     generate::{self, GridSpec},
@@ -165,10 +165,10 @@ fn print_row(r: &Row) {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.runs == 0 {
-        return Err(BadInput("--runs must be at least 1".into()).into());
+        return Err(UsageError("--runs must be at least 1".into()).into());
     }
     if args.max_grid < FIRST_GRID {
-        return Err(BadInput(format!(
+        return Err(UsageError(format!(
             "--max-grid {}: the grid rows start at {FIRST_GRID} triangles (then 10 times \
              larger up to --max-grid), so at least {FIRST_GRID}",
             args.max_grid
