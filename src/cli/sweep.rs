@@ -208,7 +208,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     .map_err(config_error)?;
     let fixed: Vec<&str> = (config.algos().iter())
         .map(String::as_str)
-        .filter(|a| matches!(*a, "greedy" | "greedy-nocrit" | "uniform"))
+        .filter(|a| quadrecomb::internals::experiment::plan::runs_as_baseline(a))
         .collect();
     if !fixed.is_empty() && !args.quiet {
         let n = config.baseline_runs();

@@ -221,7 +221,7 @@ impl SweepConfig {
         // The baseline runs count the runs of the deterministic configurations (the optimum
         // always runs once).
         let baselines: Vec<String> = (r.algos.iter())
-            .filter(|a| matches!(a.as_str(), "greedy" | "greedy-nocrit" | "uniform"))
+            .filter(|a| super::plan::runs_as_baseline(a))
             .cloned()
             .collect();
         if r.baseline_runs == 0 && !baselines.is_empty() {

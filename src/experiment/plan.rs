@@ -9,11 +9,11 @@ pub fn has_horizon(algo: &str) -> bool {
     matches!(algo, "uniform" | "selective")
 }
 
-/// Algorithms that draw nothing at random: every run of one configuration is the same run
-/// (greedy and greedy-nocrit break ties by index, the uniform tree branches on every action,
-/// the optimum is exact).
-pub fn deterministic(algo: &str) -> bool {
-    matches!(algo, "greedy" | "greedy-nocrit" | "uniform" | "optimum")
+/// Algorithms that draw nothing at random and run `baseline_runs` times (plan version 2):
+/// every run of one configuration is the same run (greedy and greedy-nocrit break ties by
+/// index, the uniform tree branches on every action). The optimum, exact, runs once.
+pub fn runs_as_baseline(algo: &str) -> bool {
+    matches!(algo, "greedy" | "greedy-nocrit" | "uniform")
 }
 
 /// Whether `spec`'s run list uses its `runs` (a randomized tree algorithm: `selective`, and

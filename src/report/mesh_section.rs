@@ -179,30 +179,26 @@ pub(super) fn greedy_paradox(doc: &mut Document, configs: &[(&Config, &[Run])]) 
     let Some((_, greedy)) = configs.iter().find(|(c, _)| c.algo == "greedy") else {
         return;
     };
-    let med = |runs: &[Run], f: &dyn Fn(&Run) -> Option<f64>| {
-        let v: Vec<f64> = runs.iter().filter_map(f).collect();
-        (!v.is_empty()).then(|| median(&v))
+    // Medians of (sum of eta, triangles left, quads, mean eta per quad); none without the
+    // element fields (records older than them).
+    let medians = |runs: &[Run]| -> Option<(f64, f64, f64, f64)> {
+        let mean: Vec<f64> = runs.iter().filter_map(|r| r.mean_eta).collect();
+        let of = |f: fn(&Run) -> f64| median(&runs.iter().map(f).collect::<Vec<_>>());
+        (!mean.is_empty()).then(|| {
+            (
+                of(|r| r.quality),
+                of(|r| r.triangles_left as f64),
+                of(|r| r.quads as f64),
+                median(&mean),
+            )
+        })
     };
-    let quality = |r: &Run| Some(r.quality);
-    let left = |r: &Run| Some(r.triangles_left as f64);
-    let quads = |r: &Run| Some(r.quads as f64);
-    let mean = |r: &Run| r.mean_eta;
-    let (Some(gq), Some(gl), Some(gn), Some(gm)) = (
-        med(greedy, &quality),
-        med(greedy, &left),
-        med(greedy, &quads),
-        med(greedy, &mean),
-    ) else {
+    let Some((gq, gl, gn, gm)) = medians(greedy) else {
         return;
     };
     let mut lines = Vec::new();
     for (c, runs) in configs.iter().filter(|(c, _)| c.horizon.is_some()) {
-        let (Some(q), Some(l), Some(n), Some(m)) = (
-            med(runs, &quality),
-            med(runs, &left),
-            med(runs, &quads),
-            med(runs, &mean),
-        ) else {
+        let Some((q, l, n, m)) = medians(runs) else {
             continue;
         };
         if q < gq && l < gl {

@@ -392,7 +392,7 @@ fn densest_window(faces: &[Face], window: [f64; 4]) -> Option<[f64; 4]> {
         window[0] + ((best % GRID) as f64 + 0.5) * dx / GRID as f64,
         window[1] + ((best / GRID) as f64 + 0.5) * dy / GRID as f64,
     );
-    let (w, h) = ((dx / 6.0).min(dx), (dx / 12.0).min(dy));
+    let (w, h) = (dx / 6.0, (dx / 12.0).min(dy));
     let x0 = (centre.0 - w / 2.0).clamp(window[0], window[2] - w);
     let y0 = (centre.1 - h / 2.0).clamp(window[1], window[3] - h);
     Some([x0, y0, x0 + w, y0 + h])

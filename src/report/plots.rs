@@ -50,11 +50,9 @@ const LEGEND_ROW: u32 = 24;
 /// Height of the title above the legend.
 const TITLE: u32 = 38;
 
-/// One legend row: a line sample (dashed or not), its colour and width, and the text.
+/// One legend row: the colour of its dashed line sample, and the text.
 struct LegendEntry {
     color: RGBColor,
-    width: u32,
-    dashed: bool,
     text: String,
 }
 
@@ -101,16 +99,12 @@ pub fn boxplot_svg(
         };
         legend.push(LegendEntry {
             color: GREY,
-            width: 2,
-            dashed: true,
             text: format!("{label} (median): {}{side}", format_tick(*v)),
         });
     }
     if let Some(fit) = &extras.fit {
         legend.push(LegendEntry {
             color: GREEN,
-            width: 2,
-            dashed: true,
             text: format!(
                 "fit h={}..{}: alpha = {:.3}",
                 fit.h_min, fit.h_max, fit.alpha
@@ -186,16 +180,14 @@ fn draw_head(
     let x = 90i32;
     for (i, e) in legend.iter().enumerate() {
         let y = (TITLE + LEGEND_ROW * i as u32 + LEGEND_ROW / 2) as i32;
-        let style = e.color.stroke_width(e.width);
-        if e.dashed {
-            for k in 0..3 {
-                let a = x + k * 10;
-                area.draw(&PathElement::new(vec![(a, y), (a + 6, y)], style))
-                    .map_err(plot_err)?;
-            }
-        } else {
-            area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], style))
-                .map_err(plot_err)?;
+        // Three dashes, as the lines they stand for are drawn.
+        for k in 0..3 {
+            let a = x + k * 10;
+            area.draw(&PathElement::new(
+                vec![(a, y), (a + 6, y)],
+                e.color.stroke_width(2),
+            ))
+            .map_err(plot_err)?;
         }
         area.draw(&Text::new(
             e.text.clone(),
@@ -484,9 +476,23 @@ mod tests {
             y[..y.find('"').unwrap()].parse::<f64>().unwrap()
         };
         assert!(text_y < box_y, "legend at y {text_y}, box at {box_y}");
+        // The grey segments drawn above the plot (the legend's sample): three short dashes,
+        // not one solid line.
         let grey = format!("stroke=\"#{:02X}{:02X}{:02X}\"", GREY.0, GREY.1, GREY.2);
-        let dashes = svg.matches(&grey).count();
-        assert!(dashes >= 4, "{dashes} grey paths: the sample is not dashed");
+        let sample: Vec<(f64, f64)> = (svg.split("<polyline").skip(1))
+            .filter(|p| p[..p.find("/>").unwrap()].contains(&grey))
+            .filter_map(|p| {
+                let pts = &p[p.find("points=\"").unwrap() + 8..];
+                let xy: Vec<f64> = pts[..pts.find('"').unwrap()]
+                    .split([' ', ','])
+                    .filter(|v| !v.is_empty())
+                    .map(|v| v.parse().unwrap())
+                    .collect();
+                (xy[1] < box_y && xy[3] < box_y).then(|| (xy[0], xy[2]))
+            })
+            .collect();
+        assert_eq!(sample.len(), 3, "legend sample {sample:?}");
+        assert!(sample.iter().all(|(a, b)| b - a <= 8.0), "{sample:?}");
         // Text large enough to print: at least 13 px at the figure's 640 px width.
         for size in svg.split("font-size=\"").skip(1) {
             let px: f64 = size[..size.find('"').unwrap()].parse().unwrap();
