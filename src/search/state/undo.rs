@@ -35,8 +35,13 @@ impl State<'_> {
             NONE
         };
         // The clean vertices now (a kept verdict's mask can be older: a recheck that
-        // finds the same local verdict keeps it).
-        let ymask = self.clean_mask(c) & 0xF;
+        // finds the same local verdict keeps it). Only forward mode's split shrinking reads
+        // them: the trees' applies skip the lookups.
+        let ymask = if self.forward {
+            self.clean_mask(c) & 0xF
+        } else {
+            0
+        };
         self.last_local_mask = ymask;
         // A distinct-components proof: its arcs' components before the unions below.
         let distinct = self.forward && r.kind == KIND_DISTINCT;
@@ -104,7 +109,9 @@ impl State<'_> {
         let qv = self.cand[ci].quad;
         for i in 1..4 {
             if let Some(child) = self.union(qv[0], qv[i]) {
-                self.attached.push(child);
+                if distinct {
+                    self.attached.push(child);
+                }
                 for j in 0..self.root_watch[child as usize].len() {
                     let (c2, ver) = self.root_watch[child as usize][j];
                     if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
