@@ -94,7 +94,7 @@ fn tie_correction(sizes: &[usize]) -> f64 {
         .sum()
 }
 
-fn ranks(values: impl Iterator<Item = f64>) -> (Vec<f64>, Vec<usize>) {
+pub(super) fn ranks(values: impl Iterator<Item = f64>) -> (Vec<f64>, Vec<usize>) {
     let v: Vec<f64> = values.collect();
     let mut order: Vec<usize> = (0..v.len()).collect();
     order.sort_by(|&a, &b| v[a].total_cmp(&v[b]));

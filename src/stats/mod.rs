@@ -2,3 +2,5 @@
 
 pub mod compare;
 pub mod describe;
+pub mod dist;
+pub mod ranks;
