@@ -95,7 +95,7 @@ fn code(e: &(dyn Error + 'static)) -> Option<u8> {
     }
     match e.downcast_ref::<ReportError>()? {
         ReportError::NotResults { .. } | ReportError::NoRuns { .. } => Some(EXIT_BAD_INPUT),
-        ReportError::NoSuchPicture(..) => Some(EXIT_USAGE),
+        ReportError::NoSuchPicture(..) | ReportError::NoSuchBaseline(..) => Some(EXIT_USAGE),
         // Transparent: the inner error is not in the chain.
         ReportError::Results(inner) => experiment_code(inner),
         _ => None,

@@ -23,6 +23,11 @@ pub struct Args {
     /// Leave out the mesh pictures (they re-run each typical run).
     #[arg(long)]
     no_pictures: bool,
+    /// Across meshes (two or more): the method every other is compared with, as the report
+    /// names it, e.g. "selective h=3" (default: selective h=1, else the first method run on
+    /// every mesh).
+    #[arg(long, value_name = "METHOD")]
+    baseline: Option<String>,
     /// Seed of the bootstrap confidence intervals.
     #[arg(long, default_value_t = ReportOptions::default().seed)]
     seed: u64,
@@ -34,11 +39,15 @@ pub struct Args {
 /// The files a report wrote, as the `report` member of a `--json` object (`sweep`,
 /// `merge`) or the whole of `report --json`'s.
 pub fn paths_json(paths: &report::ReportPaths) -> serde_json::Value {
-    serde_json::json!({
+    let mut v = serde_json::json!({
         "markdown": paths.markdown,
         "html": paths.html,
         "figures": paths.figures,
-    })
+    });
+    if let Some(csv) = &paths.across_csv {
+        v["across_meshes"] = serde_json::json!(csv);
+    }
+    v
 }
 
 /// Parses "x0,y0,x1,y1" into a window with x0 < x1 and y0 < y1.
@@ -90,6 +99,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         pictures: !args.no_pictures,
         picture_configs,
         seed: args.seed,
+        baseline: args.baseline,
     };
     // Its exit code follows the error's kind (`errors::exit_code`).
     let paths = report::write(&args.dir, &opts)?;
@@ -104,6 +114,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     println!("{}", paths.html.display());
     for f in &paths.figures {
         println!("{}", f.display());
+    }
+    if let Some(csv) = &paths.across_csv {
+        println!("{}", csv.display());
     }
     Ok(ExitCode::SUCCESS)
 }

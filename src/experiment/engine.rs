@@ -302,6 +302,7 @@ fn clear_results(dir: &Path) -> Result<(), ExperimentError> {
             MANIFEST_FILE,
             summary::SUMMARY_CSV,
             summary::SUMMARY_JSON,
+            ACROSS_CSV,
             "report.md",
             "report.html",
         ]
@@ -326,6 +327,8 @@ fn clear_results(dir: &Path) -> Result<(), ExperimentError> {
 pub const REPORT_FILES: &str = "report-files.txt";
 /// Sub-directory of a report's figures.
 pub const FIGURES_DIR: &str = "figures";
+/// The per-mesh medians a report of two or more meshes writes (`report::across`).
+pub const ACROSS_CSV: &str = "across_meshes.csv";
 
 /// The figures `dir`'s last report wrote (from [`REPORT_FILES`]; none if it is missing).
 /// Only plain `figures/NAME.svg` paths are taken: a line naming anything else is an error,

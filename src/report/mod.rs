@@ -8,8 +8,10 @@
 //! Mann–Whitney/Holm/Vargha–Delaney/bootstrap comparisons of consecutive horizons and against
 //! greedy; with [`ReportOptions::compare`], also one directory against another.
 
+pub mod across;
 mod beside_paper;
 mod box_plots;
+pub mod cd_diagram;
 mod compare;
 mod document;
 mod format;
@@ -62,6 +64,9 @@ pub enum ReportError {
     /// `--picture` names a configuration the results do not hold.
     #[error("--picture {0}: no such configuration in these results (they hold: {1})")]
     NoSuchPicture(String, String),
+    /// `--baseline` names no method of the results.
+    #[error("--baseline {0:?}: no such method in these results (they hold: {1})")]
+    NoSuchBaseline(String, String),
     /// plotters failed to draw (an internal error).
     #[error("drawing a figure failed: {0}")]
     Plot(String),
@@ -81,6 +86,10 @@ pub struct ReportOptions {
     pub picture_configs: Vec<(String, Option<u32>)>,
     /// Seed of the bootstrap resampling.
     pub seed: u64,
+    /// The method the "Across meshes" section compares every other with, as the report names
+    /// it (e.g. "selective h=1"); `None`: selective h=1 if run on every mesh, else the first
+    /// method that was.
+    pub baseline: Option<String>,
 }
 
 impl Default for ReportOptions {
@@ -91,6 +100,7 @@ impl Default for ReportOptions {
             pictures: true,
             picture_configs: Vec::new(),
             seed: 0x5EED_2026,
+            baseline: None,
         }
     }
 }
@@ -104,6 +114,8 @@ pub struct ReportPaths {
     pub html: PathBuf,
     /// SVG figures under `figures/`.
     pub figures: Vec<PathBuf>,
+    /// `across_meshes.csv`, the per-mesh medians, written for two or more meshes.
+    pub across_csv: Option<PathBuf>,
 }
 
 pub use crate::experiment::engine::FIGURES_DIR;
@@ -127,6 +139,18 @@ pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportErro
     let earlier = crate::experiment::engine::report_files(dir)?;
     let mut figures = Vec::new();
     let mut list = String::new();
+    // The per-mesh medians (two or more meshes); a stale one of an earlier report goes.
+    let across_path = dir.join(across::ACROSS_CSV);
+    let across_csv = match across::csv(&results, &summary) {
+        Some(csv) => {
+            crate::output::write_bytes(&across_path, csv.as_bytes()).map_err(io(&across_path))?;
+            Some(across_path)
+        }
+        None => {
+            let _ = std::fs::remove_file(&across_path);
+            None
+        }
+    };
     for (file, svg) in doc.figures() {
         let path = dir.join(file);
         crate::output::write_bytes(&path, svg.as_bytes()).map_err(io(&path))?;
@@ -152,6 +176,7 @@ pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportErro
         markdown,
         html,
         figures,
+        across_csv,
     })
 }
 
@@ -165,6 +190,7 @@ pub fn build(
     opts: &ReportOptions,
 ) -> Result<Document, ReportError> {
     pictures::check_pictures(results, opts)?;
+    across::check_baseline(results, opts)?;
     let mut doc = Document::default();
     doc.heading(1, format!("quadrecomb report: {}", results.dir.display()));
     overview::overview(&mut doc, results);
@@ -180,6 +206,7 @@ pub fn build(
             &mut replayer,
         )?;
     }
+    across::across_meshes(&mut doc, results, summary, opts)?;
     if let Some(other) = other {
         compare::compare_section(&mut doc, results, other, opts.seed.wrapping_add(7_777_777));
     }

@@ -97,6 +97,15 @@ pub fn friedman(values: &[Vec<f64>]) -> Option<Friedman> {
     })
 }
 
+/// The smallest p-value Friedman's exact test can give for `k` methods over `n` blocks:
+/// every block ranking the methods the same way without ties, `(k!)^(1-n)` (each block's
+/// ranking is one of k! equally likely ones under the null hypothesis). Above 0.05, no data
+/// of that shape can be significant.
+pub fn friedman_min_p(k: usize, n: usize) -> f64 {
+    let ln_k_factorial: f64 = (2..=k).map(|i| (i as f64).ln()).sum();
+    (-(n.max(1) as f64 - 1.0) * ln_k_factorial).exp().min(1.0)
+}
+
 /// The critical values `q_0.05` of the two-tailed Nemenyi test for `k = 2..=20` methods: the
 /// studentized range's 95 % quantile with infinite degrees of freedom over sqrt 2 (Demšar's
 /// Table 5a up to k = 10). scipy 1.17.1:
@@ -276,6 +285,33 @@ mod tests {
             "{}",
             pairs[1].p_holm
         );
+    }
+
+    #[test]
+    fn smallest_friedman_p() {
+        // k = 2 over n = 5: 2!^-4 = 1/16; k = 3 over 3: 6^-2 = 1/36; one block: 1.
+        assert!(close(friedman_min_p(2, 5), 0.0625, 1e-12));
+        assert!(close(friedman_min_p(3, 3), 1.0 / 36.0, 1e-12));
+        assert_eq!(friedman_min_p(4, 1), 1.0);
+        // By brute force for k = 3, n = 2: of the 36 pairs of rankings, the 6 where both
+        // blocks agree give the largest statistic.
+        let perms = [
+            [1.0, 2.0, 3.0],
+            [1.0, 3.0, 2.0],
+            [2.0, 1.0, 3.0],
+            [2.0, 3.0, 1.0],
+            [3.0, 1.0, 2.0],
+            [3.0, 2.0, 1.0],
+        ];
+        let mut stats = Vec::new();
+        for a in &perms {
+            for b in &perms {
+                stats.push(friedman(&[a.to_vec(), b.to_vec()]).unwrap().chi2);
+            }
+        }
+        let max = stats.iter().copied().fold(0.0, f64::max);
+        let at_max = stats.iter().filter(|s| (**s - max).abs() < 1e-9).count();
+        assert!(close(at_max as f64 / 36.0, friedman_min_p(3, 2), 1e-12));
     }
 
     #[test]
