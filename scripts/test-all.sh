@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The full test suite, installing what it needs: lavapipe (Mesa's software Vulkan, Debian
-# package mesa-vulkan-drivers) for the GPU tests, Gmsh, meshio and VTK from PyPI for the checks that read our files.
+# package mesa-vulkan-drivers) for the GPU tests, Gmsh, meshio and VTK from PyPI for the checks that read our files, scipy for the statistics.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -15,9 +15,9 @@ if ! python3 -c "import gmsh" >/dev/null 2>&1; then
   echo "== installing gmsh 4.15.2 from PyPI (tests and data only)"
   python3 -m pip install -q gmsh==4.15.2 || echo "warning: could not install gmsh; its round-trip tests will skip"
 fi
-for mod in meshio==5.3.5 vtk==9.7.2; do
+for mod in meshio==5.3.5 vtk==9.7.2 scipy==1.17.1; do
   if ! python3 -c "import ${mod%%==*}" >/dev/null 2>&1; then
-    echo "== installing $mod from PyPI (reads our .msh/.vtu files in the tests)"
+    echo "== installing $mod from PyPI (reads our .msh/.vtu files, checks our statistics in the tests)"
     python3 -m pip install -q "$mod" || echo "warning: could not install $mod; its checks will skip outside CI"
   fi
 done

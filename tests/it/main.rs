@@ -1,5 +1,6 @@
 //! The one integration-test binary: each module tests one area through the library or the CLI.
 
+mod across;
 mod cli_edge;
 mod files;
 mod gpu;

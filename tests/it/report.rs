@@ -220,7 +220,7 @@ const CONFIGS: [(&str, Option<u32>); 6] = [
 
 /// One line of `runs.jsonl`: a runner `RunRecord`.
 #[allow(clippy::too_many_arguments)]
-fn record(
+pub(crate) fn record(
     mesh: &str,
     algo: &str,
     horizon: Option<u32>,
@@ -440,7 +440,7 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
 }
 
 /// Parses an SVG through usvg and renders it through resvg; returns the ids of its elements.
-fn parse_and_render(svg: &str) -> Vec<String> {
+pub(crate) fn parse_and_render(svg: &str) -> Vec<String> {
     let tree = resvg::usvg::Tree::from_str(svg, &resvg::usvg::Options::default())
         .unwrap_or_else(|e| panic!("SVG does not parse: {e}"));
     let size = tree.size().to_int_size();
