@@ -8,10 +8,10 @@
 //! Mann–Whitney/Holm/Vargha–Delaney/bootstrap comparisons of consecutive horizons and against
 //! greedy; with [`ReportOptions::compare`], also one directory against another.
 
-pub mod across;
+mod across;
 mod beside_paper;
 mod box_plots;
-pub mod cd_diagram;
+mod cd_diagram;
 mod compare;
 mod document;
 mod format;
