@@ -274,3 +274,35 @@ fn unknown_baseline_is_a_usage_error() {
     assert!(md.contains("### Against selective h=3"), "{md}");
     assert!(md.contains("(chosen with --baseline)"), "{md}");
 }
+
+#[test]
+fn the_deepest_horizon_is_asked_about_too_when_it_is_not_the_best() {
+    // Three meshes where selective h=3 is best; h=5 beats h=1 on two of them and ties on "c".
+    let tmp = tempfile::tempdir().unwrap();
+    let mut lines = Vec::new();
+    for (mesh, h5) in [("a", 92.0), ("b", 93.0), ("c", 90.0)] {
+        for (h, centre) in [(1, 90.0), (3, 95.0), (5, h5)] {
+            for run in 0..8 {
+                let q = centre + f64::from(run) * 0.01;
+                lines.push(record(mesh, "selective", Some(h), run, q, 95.0, 0.05));
+            }
+        }
+    }
+    std::fs::write(tmp.path().join("runs.jsonl"), lines.join("\n") + "\n").unwrap();
+    let md = std::fs::read_to_string(report::write(tmp.path(), &opts()).unwrap().markdown).unwrap();
+    let best = (md.lines())
+        .find(|l| l.starts_with("Does selective h=3 (the best average rank"))
+        .unwrap_or_else(|| panic!("{md}"));
+    assert!(best.contains("selective h=1 on every mesh? Yes:"), "{best}");
+    let deepest = (md.lines())
+        .find(|l| l.starts_with("Does selective h=5 (the deepest horizon, average rank 2.17)"))
+        .unwrap_or_else(|| panic!("{md}"));
+    assert!(
+        deepest.contains("No: it is significantly higher on 2 of the 3 meshes"),
+        "{deepest}"
+    );
+    assert!(
+        deepest.contains("not on c (tie: "),
+        "{deepest}"
+    );
+}
