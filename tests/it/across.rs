@@ -301,8 +301,5 @@ fn the_deepest_horizon_is_asked_about_too_when_it_is_not_the_best() {
         deepest.contains("No: it is significantly higher on 2 of the 3 meshes"),
         "{deepest}"
     );
-    assert!(
-        deepest.contains("not on c (tie: "),
-        "{deepest}"
-    );
+    assert!(deepest.contains("not on c (tie: "), "{deepest}");
 }

@@ -712,8 +712,10 @@ fn report_escapes_mesh_names_and_keeps_figures_apart() {
         "{md}"
     );
     let listed: Vec<String> = lines_of(&tmp.path().join("d/report-files.txt"));
-    // Three box plots and one picture per mesh, none shared.
-    assert_eq!(listed.len(), 3 * 4, "{listed:?}");
+    // Three box plots and one picture per mesh, none shared, and the critical-difference
+    // diagram across the three meshes.
+    assert_eq!(listed.len(), 3 * 4 + 1, "{listed:?}");
+    assert!(listed.contains(&"figures/across-meshes-cd.svg".to_string()));
     let unique: std::collections::BTreeSet<_> = listed.iter().collect();
     assert_eq!(unique.len(), listed.len(), "{listed:?}");
     for f in &listed {
