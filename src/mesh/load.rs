@@ -35,7 +35,20 @@ pub fn source(spec: &str) -> Result<Source, ReadError> {
                     names: suite::member_names(),
                 });
             }
-            None => {}
+            None => {
+                if let Some(member) = suite::member(spec) {
+                    return Err(ReadError::Io {
+                        path: path.to_path_buf(),
+                        source: std::io::Error::new(
+                            std::io::ErrorKind::NotFound,
+                            format!(
+                                "no such file; the benchmark suite's mesh of that name is {}",
+                                suite::spec(member)
+                            ),
+                        ),
+                    });
+                }
+            }
         }
     }
     if !path.exists() {

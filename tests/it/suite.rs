@@ -118,6 +118,14 @@ fn unknown_suite_names_are_errors_that_list_the_names() {
         err.contains("no suite mesh is named \"tours\"") && err.contains("torus, capped-cylinder"),
         "{err}"
     );
+    // A suite member's plain name that is no file points to its spec.
+    let out = run_in(dir.path(), &["info", "torus"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("torus: no such file; the benchmark suite's mesh of that name is suite:torus"),
+        "{err}"
+    );
     let out = run_in(dir.path(), &["sweep", "--suite", "huge"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
