@@ -36,7 +36,9 @@ pub fn source(spec: &str) -> Result<Source, ReadError> {
                 });
             }
             None => {
-                if let Some(member) = suite::member(spec) {
+                // (The built-in members, sphere and borouchaki, load by their plain names.)
+                let member = suite::member(spec).filter(|_| builtin::bytes(spec).is_none());
+                if let Some(member) = member {
                     return Err(ReadError::Io {
                         path: path.to_path_buf(),
                         source: std::io::Error::new(

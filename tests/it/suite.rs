@@ -126,6 +126,13 @@ fn unknown_suite_names_are_errors_that_list_the_names() {
         err.contains("torus: no such file; the benchmark suite's mesh of that name is suite:torus"),
         "{err}"
     );
+    // Built-in members still load by their plain names.
+    let out = run_in(dir.path(), &["info", "sphere"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = run_in(dir.path(), &["sweep", "--suite", "huge"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
