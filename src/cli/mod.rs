@@ -12,6 +12,7 @@ mod progress_bar;
 mod recombine;
 mod replay;
 mod report;
+mod suite;
 mod sweep;
 mod sweep_progress;
 
@@ -47,6 +48,8 @@ enum Command {
     Replay(replay::Args),
     /// Print benchmark figures.
     Bench(bench::Args),
+    /// The benchmark suite's meshes (`suite list`), named suite:NAME anywhere a mesh is taken.
+    Suite(suite::Args),
     /// Print a shell completion script (bash, zsh, fish) on stdout.
     Completions(completions::Args),
 }
@@ -64,6 +67,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Report(args) => report::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Suite(args) => suite::run(args),
         Command::Completions(args) => completions::run(args, Cli::command()),
     }
 }

@@ -8,6 +8,7 @@ use anyhow::Context;
 use quadrecomb::internals::experiment::config::{
     ConfigError, DEFAULT_SEED, MAX_HORIZONS, MAX_RUNS, SizeError, SweepConfig, SweepRequest,
 };
+use quadrecomb::internals::experiment::events::Event;
 use quadrecomb::internals::experiment::manifest::Shard;
 use quadrecomb::internals::experiment::sweep;
 use quadrecomb::internals::gpu::Backend;
@@ -39,19 +40,26 @@ impl From<BackendArg> for Backend {
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Meshes (built-in names or files); default: borouchaki.
+    /// Meshes (built-in names, suite:NAME, or files); default: borouchaki.
     #[arg(long = "mesh", value_name = "MESH", num_args = 1..)]
     meshes: Vec<String>,
+    /// Every mesh of a benchmark suite (default, small, full: `quadrecomb suite list`), with
+    /// the suite's defaults: --algo greedy selective optimum, --horizons 1,3,5, --runs 32
+    /// (each can still be given), into results/suite (results/suite-<name> for the others).
+    #[arg(long, value_name = "SUITE", conflicts_with = "meshes")]
+    suite: Option<String>,
     /// Algorithms: selective, uniform, greedy, greedy-nocrit, optimum;
     /// default: selective greedy greedy-nocrit optimum.
     #[arg(long = "algo", value_name = "ALGO", num_args = 1..)]
     algos: Vec<String>,
-    /// Horizons of selective and uniform: a range A..B (inclusive), a list 1,3,5, or one value.
-    #[arg(long, value_name = "H", default_value = "1..10", value_parser = parse_horizons)]
-    horizons: Horizons,
-    /// Runs per (mesh, selective, horizon): the randomized configurations.
-    #[arg(long, default_value_t = 128)]
-    runs: u32,
+    /// Horizons of selective and uniform: a range A..B (inclusive), a list 1,3,5, or one value
+    /// [default: 1..10; with --suite, 1,3,5].
+    #[arg(long, value_name = "H", value_parser = parse_horizons)]
+    horizons: Option<Horizons>,
+    /// Runs per (mesh, selective, horizon): the randomized configurations [default: 128; with
+    /// --suite, 32].
+    #[arg(long)]
+    runs: Option<u32>,
     /// Runs of each deterministic configuration: greedy and greedy-nocrit per mesh (ties are
     /// broken by index), uniform per horizon (it draws nothing at random). More than 1 only
     /// repeats the same run, for its timings.
@@ -166,15 +174,27 @@ static CANCEL: AtomicBool = AtomicBool::new(false);
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let start = std::time::Instant::now();
-    let paper = SweepRequest::default();
+    let mut paper = SweepRequest::default();
+    let suite_defaults = args.suite.as_deref().map(suite_request).transpose()?;
+    if let Some(s) = &suite_defaults {
+        paper = SweepRequest {
+            meshes: s.meshes.clone(),
+            algos: s.algos.clone(),
+            horizons: s.horizons.clone(),
+            runs: s.runs,
+            ..paper
+        };
+    }
     let meshes = if args.meshes.is_empty() {
         paper.meshes.clone()
     } else {
         args.meshes
     };
     let out = args.out.unwrap_or_else(|| {
-        let base = match meshes.as_slice() {
-            [one] => sweep::mesh_name(one),
+        let base = match (&args.suite, meshes.as_slice()) {
+            (Some(s), _) if s == "default" => "suite".to_string(),
+            (Some(s), _) => format!("suite-{s}"),
+            (None, [one]) => sweep::mesh_name(one),
             _ => "sweep".to_string(),
         };
         // Shards get a directory each, so that they never share a run log.
@@ -192,8 +212,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         } else {
             args.algos
         },
-        horizons: args.horizons.0,
-        runs: args.runs,
+        horizons: args.horizons.map_or(paper.horizons.clone(), |h| h.0),
+        runs: args.runs.unwrap_or(paper.runs),
         baseline_runs: args.baseline_runs,
         seed: args.seed,
         threads: args.threads.unwrap_or(paper.threads),
@@ -241,12 +261,25 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     })
     .context("installing the Ctrl-C handler")?;
 
-    let (manifest, report) = sweep::run(&config, &CANCEL, &mut |e| display.event(e))?;
+    // The searches' wall time: from the engine's start of the runs to their end.
+    let (mut runs_start, mut runs_end) = (None, None);
+    let (manifest, report, phases) = sweep::run_timed(&config, &CANCEL, &mut |e| {
+        match e {
+            Event::Started { .. } => runs_start = Some(std::time::Instant::now()),
+            Event::Finished => runs_end = Some(std::time::Instant::now()),
+            _ => {}
+        }
+        display.event(e)
+    })?;
+    let searches_s = match (runs_start, runs_end) {
+        (Some(a), Some(b)) => b.duration_since(a).as_secs_f64(),
+        _ => 0.0,
+    };
     let shard = manifest
         .shard
         .map(|s| format!(" (shard {s})"))
         .unwrap_or_default();
-    let json = |report_paths: serde_json::Value| {
+    let json = |report_paths: serde_json::Value, phases: serde_json::Value| {
         let v = serde_json::json!({
             "out": out,
             "runs": report.planned,
@@ -258,12 +291,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "files": result_files(&out),
             "report": report_paths,
             "time_s": start.elapsed().as_secs_f64(),
+            "phases": phases,
         });
         println!("{v}");
     };
     if report.cancelled {
         if args.json {
-            json(serde_json::Value::Null);
+            json(serde_json::Value::Null, serde_json::Value::Null);
         }
         eprintln!(
             "sweep: interrupted: {} of {} runs recorded in {}{shard}; run the same command with {} to finish",
@@ -285,6 +319,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
     }
     let mut report_paths = serde_json::Value::Null;
+    let report_clock = std::time::Instant::now();
     if !args.no_report && manifest.shard.is_none() {
         let paths = quadrecomb::internals::report::write(
             &out,
@@ -303,10 +338,89 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
         report_paths = super::report::paths_json(&paths);
     }
+    let timing = Timing {
+        phases,
+        searches_s,
+        report_s: report_clock.elapsed().as_secs_f64(),
+        total_s: start.elapsed().as_secs_f64(),
+    };
+    if !args.quiet {
+        eprintln!("sweep: {}", timing.line());
+    }
     if args.json {
-        json(report_paths);
+        json(report_paths, timing.json());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Where a sweep's wall time went: the runner's phases against its searches.
+struct Timing {
+    phases: sweep::PhaseTimes,
+    /// From the first run handed out to the last one recorded.
+    searches_s: f64,
+    /// Writing the report (0 with --no-report).
+    report_s: f64,
+    /// The whole command.
+    total_s: f64,
+}
+
+impl Timing {
+    /// Everything but the searches: loading, eta, optimum, the engine's own work (manifest,
+    /// checks, summary), the report and the command's start.
+    fn overhead_s(&self) -> f64 {
+        (self.total_s - self.searches_s).max(0.0)
+    }
+
+    fn line(&self) -> String {
+        let p = &self.phases;
+        format!(
+            "time {:.2} s: searches {:.2} s; runner {:.2} s = {:.1} % (load {:.2} s, eta {:.2} \
+             s, optimum {:.2} s, engine besides the runs {:.2} s, report {:.2} s)",
+            self.total_s,
+            self.searches_s,
+            self.overhead_s(),
+            100.0 * self.overhead_s() / self.total_s.max(f64::MIN_POSITIVE),
+            p.load_s,
+            p.eta_s,
+            p.optimum_s,
+            (p.engine_s - self.searches_s).max(0.0),
+            self.report_s
+        )
+    }
+
+    fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "load_s": self.phases.load_s,
+            "eta_s": self.phases.eta_s,
+            "optimum_s": self.phases.optimum_s,
+            "engine_s": self.phases.engine_s,
+            "searches_s": self.searches_s,
+            "report_s": self.report_s,
+            "overhead_s": self.overhead_s(),
+            "overhead_pct": 100.0 * self.overhead_s() / self.total_s.max(f64::MIN_POSITIVE),
+        })
+    }
+}
+
+/// The meshes and defaults of `sweep --suite NAME`: every member, the issue's methods
+/// (greedy, selective h = 1, 3, 5, optimum), 32 runs.
+fn suite_request(name: &str) -> Result<SweepRequest, UsageError> {
+    use quadrecomb::internals::mesh::suite;
+    let members = suite::suite(name).ok_or_else(|| {
+        UsageError(format!(
+            "--suite {name:?}: no such suite (suites: {}; `quadrecomb suite list` shows them)",
+            suite::suite_names()
+        ))
+    })?;
+    Ok(SweepRequest {
+        meshes: members.iter().map(|m| suite::spec(m)).collect(),
+        algos: ["greedy", "selective", "optimum"]
+            .map(String::from)
+            .to_vec(),
+        horizons: vec![1, 3, 5],
+        runs: 32,
+        ..SweepRequest::default()
+    })
 }
 
 /// A configuration error worded with the flags that set the values it names.

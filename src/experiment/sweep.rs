@@ -30,12 +30,32 @@ pub struct Prepared {
     pub tables: Vec<CandidateTable>,
     /// The manifest to write.
     pub manifest: Manifest,
+    /// How long each step of the preparation took.
+    pub phases: PhaseTimes,
 }
 
-/// The name a mesh has in records: the built-in name, or the file stem.
+/// Wall time of a sweep's phases (seconds): what the runner spends besides the searches.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct PhaseTimes {
+    /// Loading and validating the meshes.
+    pub load_s: f64,
+    /// Candidate tables: topology, the evaluator (device opened, one batch for every mesh),
+    /// restriction to the rule.
+    pub eta_s: f64,
+    /// The optimum of every mesh (solved, or read from the cache and verified).
+    pub optimum_s: f64,
+    /// The engine: manifest, records checked, the runs (searches), the summary.
+    pub engine_s: f64,
+}
+
+/// The name a mesh has in records: the built-in name, the suite member's name (`suite:torus`
+/// is `torus`), or the file stem.
 pub fn mesh_name(spec: &str) -> String {
     if crate::mesh::builtin::NAMES.contains(&spec) {
         return spec.to_string();
+    }
+    if let Some(Ok(member)) = crate::mesh::suite::parse_spec(spec) {
+        return member.name.to_string();
     }
     Path::new(spec)
         .file_stem()
@@ -46,6 +66,8 @@ pub fn mesh_name(spec: &str) -> String {
 /// under the results directory) the optimum of each mesh. How the backend was chosen goes
 /// to `events`.
 pub fn prepare(config: &SweepConfig, events: &mut Events<'_>) -> Result<Prepared, ExperimentError> {
+    let mut phases = PhaseTimes::default();
+    let clock = std::time::Instant::now();
     let mut meshes = Vec::new();
     let mut entries: Vec<MeshEntry> = Vec::new();
     for spec in config.meshes() {
@@ -79,6 +101,8 @@ pub fn prepare(config: &SweepConfig, events: &mut Events<'_>) -> Result<Prepared
         entries.push(entry);
         meshes.push(mesh);
     }
+    phases.load_s = clock.elapsed().as_secs_f64();
+    let clock = std::time::Instant::now();
     let evaluator = Evaluator::new(config.backend())?;
     for note in evaluator.notes() {
         events(Event::Backend(note));
@@ -93,6 +117,8 @@ pub fn prepare(config: &SweepConfig, events: &mut Events<'_>) -> Result<Prepared
     let tables: Vec<CandidateTable> = (meshes.iter().zip(tables))
         .map(|(mesh, table)| table.restrict(mesh, config.rule()))
         .collect();
+    phases.eta_s = clock.elapsed().as_secs_f64();
+    let clock = std::time::Instant::now();
     let mut optimum = Vec::new();
     for ((mesh, table), entry) in meshes.iter().zip(&tables).zip(&entries) {
         optimum.push(cached_optimum(
@@ -103,6 +129,7 @@ pub fn prepare(config: &SweepConfig, events: &mut Events<'_>) -> Result<Prepared
             config.overwrite(),
         )?);
     }
+    phases.optimum_s = clock.elapsed().as_secs_f64();
     let manifest = Manifest {
         version: super::VERSION.to_string(),
         spec: config.spec(entries),
@@ -118,6 +145,7 @@ pub fn prepare(config: &SweepConfig, events: &mut Events<'_>) -> Result<Prepared
         meshes,
         tables,
         manifest,
+        phases,
     })
 }
 
@@ -275,8 +303,18 @@ pub fn run(
     cancel: &AtomicBool,
     events: &mut Events<'_>,
 ) -> Result<(Manifest, EngineReport), ExperimentError> {
+    run_timed(config, cancel, events).map(|(m, r, _)| (m, r))
+}
+
+/// [`run`], with the time each phase took.
+pub fn run_timed(
+    config: &SweepConfig,
+    cancel: &AtomicBool,
+    events: &mut Events<'_>,
+) -> Result<(Manifest, EngineReport, PhaseTimes), ExperimentError> {
     let prepared = prepare(config, events)?;
     let factory = SearchFactory::new(&prepared);
+    let clock = std::time::Instant::now();
     let report = engine::run(
         &prepared.manifest,
         &factory,
@@ -284,5 +322,9 @@ pub fn run(
         cancel,
         events,
     )?;
-    Ok((prepared.manifest.clone(), report))
+    let phases = PhaseTimes {
+        engine_s: clock.elapsed().as_secs_f64(),
+        ..prepared.phases
+    };
+    Ok((prepared.manifest.clone(), report, phases))
 }

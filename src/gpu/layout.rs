@@ -132,6 +132,17 @@ impl Batch {
         Batch::default()
     }
 
+    /// An empty batch with room for `meshes` meshes of `vertices` vertices and `quads`
+    /// candidates in all: pushing them then moves nothing (a batch of a whole suite grown
+    /// push by push reallocated its arrays several times).
+    pub fn with_capacity(vertices: usize, quads: usize, meshes: usize) -> Batch {
+        Batch {
+            vertices: Vec::with_capacity(vertices),
+            quads: Vec::with_capacity(quads),
+            meshes: Vec::with_capacity(meshes),
+        }
+    }
+
     /// Appends one mesh's vertices and candidate quads (indices local to `vertices`) and
     /// returns its index. Positions are normalised by the mesh's bounding box so that f32
     /// keeps its precision for huge and tiny coordinates.

@@ -244,7 +244,11 @@ impl Evaluator {
     /// Fills the eta column of every table (built with
     /// [`CandidateTable::topology_only`] or [`CandidateTable::build`]) in one batch.
     pub fn fill(&self, jobs: &mut [(&Mesh, &mut CandidateTable)]) -> Result<(), GpuError> {
-        let mut batch = Batch::new();
+        let mut batch = Batch::with_capacity(
+            jobs.iter().map(|(m, _)| m.vertices.len()).sum(),
+            jobs.iter().map(|(_, t)| t.quads.len()).sum(),
+            jobs.len(),
+        );
         for (mesh, table) in jobs.iter() {
             batch.push(&mesh.vertices, &table.quads)?;
         }

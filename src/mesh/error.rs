@@ -82,6 +82,9 @@ pub enum ReadError {
     },
     #[error("{path}: {source}")]
     Mesh { path: PathBuf, source: MeshError },
+    /// `suite:NAME` with a name the suite does not have.
+    #[error("no suite mesh is named {name:?} (suite meshes: {names})")]
+    UnknownSuiteMember { name: String, names: String },
 }
 
 /// Why a triangle of relative height `10^lg` is degenerate, in words.

@@ -1,7 +1,7 @@
 //! Loading a mesh from a path or a built-in name. The format is detected from the content
 //! (`$MeshFormat` header, version, file type), never from the file's extension.
 
-use super::{Mesh, ReadError, builtin, msh, order};
+use super::{Mesh, ReadError, builtin, msh, order, suite};
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
@@ -16,9 +16,43 @@ pub struct Source {
     pub bytes: Cow<'static, [u8]>,
 }
 
-/// Finds the bytes of `spec`: an existing file path first, then a built-in name.
+/// Finds the bytes of `spec`: an existing file path first, then a built-in name or a suite
+/// member (`suite:NAME`, [`suite::PREFIX`]).
 pub fn source(spec: &str) -> Result<Source, ReadError> {
     let path = Path::new(spec);
+    if !path.exists() {
+        match suite::parse_spec(spec) {
+            Some(Ok(member)) => {
+                return Ok(Source {
+                    path: path.to_path_buf(),
+                    builtin: true,
+                    bytes: member.bytes(),
+                });
+            }
+            Some(Err(name)) => {
+                return Err(ReadError::UnknownSuiteMember {
+                    name: name.to_string(),
+                    names: suite::member_names(),
+                });
+            }
+            None => {
+                // (The built-in members, sphere and borouchaki, load by their plain names.)
+                let member = suite::member(spec).filter(|_| builtin::bytes(spec).is_none());
+                if let Some(member) = member {
+                    return Err(ReadError::Io {
+                        path: path.to_path_buf(),
+                        source: std::io::Error::new(
+                            std::io::ErrorKind::NotFound,
+                            format!(
+                                "no such file; the benchmark suite's mesh of that name is {}",
+                                suite::spec(member)
+                            ),
+                        ),
+                    });
+                }
+            }
+        }
+    }
     if !path.exists() {
         if let Some(bytes) = builtin::bytes(spec) {
             return Ok(Source {

@@ -7,6 +7,7 @@ pub mod generate;
 mod load;
 pub mod msh;
 pub mod order;
+pub mod suite;
 pub(crate) mod topology;
 pub mod vtu;
 

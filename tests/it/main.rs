@@ -16,5 +16,6 @@ mod runner;
 mod runner_extend;
 mod search;
 mod search_oracle;
+mod suite;
 mod util;
 mod valid_output;

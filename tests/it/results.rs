@@ -25,6 +25,7 @@ const CASES: &[(&str, &[&str], &str, u32)] = &[
         "1..2",
         2,
     ),
+    ("results/suite", &["selective", "greedy"], "1", 2),
 ];
 
 fn committed(dir: &Path) -> Option<(Manifest, Vec<RunRecord>)> {
@@ -74,7 +75,8 @@ fn a_reduced_sweep_reproduces_the_committed_records() {
         };
         let tmp = tempfile::tempdir().unwrap();
         let out = tmp.path().join("out");
-        let mesh = &manifest.spec.meshes[0].name;
+        // The spec it was loaded from (`suite:torus` for a suite member, named `torus`).
+        let mesh = &manifest.spec.meshes[0].source;
         let seed = manifest.spec.seed.to_string();
         let runs = runs.to_string();
         let mut args = vec!["sweep", "--mesh", mesh, "--algo"];

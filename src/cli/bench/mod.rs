@@ -6,6 +6,7 @@ mod memory;
 mod optimum;
 mod rss;
 mod search;
+mod suite_eval;
 
 use std::process::ExitCode;
 
@@ -25,6 +26,9 @@ enum What {
     Optimum(optimum::Args),
     /// Quad-quality evaluation: CPU, lavapipe, GPU.
     Gpu(gpu::Args),
+    /// Filling a suite's candidate tables: one device batch, one submission per mesh, the
+    /// CPU twin.
+    SuiteEval(suite_eval::Args),
     /// This machine's random-access latency by working-set size (what large meshes cost).
     Memory(memory::Args),
     /// Peak resident memory of `recombine` per triangle on generated shapes (grid, strip,
@@ -38,6 +42,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         What::Search(a) => search::run(a),
         What::Optimum(a) => optimum::run(a),
         What::Gpu(a) => gpu::run(a),
+        What::SuiteEval(a) => suite_eval::run(a),
         What::Memory(a) => memory::run(a),
         What::Rss(a) => rss::run(a),
     }
