@@ -139,7 +139,6 @@ impl<'a> State<'a> {
                 }
                 TriRecord {
                     ring: r,
-                    nb: nb[t],
                     cands: table.by_triangle[t],
                 }
             })
@@ -179,6 +178,7 @@ impl<'a> State<'a> {
             tree: Overlay::new(m, nv, nt),
             forward: false,
             initial: None,
+            building: true,
             last_local: NONE,
             last_local_mask: 0,
             stamp: vec![0; nt],
@@ -224,8 +224,9 @@ impl<'a> State<'a> {
             }
         }
         drop(acyclic);
-        // The initial verdicts are the base state: nothing to undo before it (and the log's
-        // memory, as large as every initial change, is given back).
+        // The initial verdicts are the base state: nothing to undo before it (their changes
+        // were not logged; the few unions of the boundary were).
+        st.building = false;
         st.log = Vec::new();
         st.base_cert_init = st.base_cert.len();
         st.base_cert.shrink_to_fit();
