@@ -84,6 +84,9 @@ impl<'a> State<'a> {
                 false
             })
             .collect();
+        // The build's scratch goes before the initial verdicts, which set the state's peak
+        // (on corridors, where the state is all there is).
+        drop((vt_count, vt_first, has_quad));
         let mut vc_start = vec![0u32; nv + 1];
         for q in &table.quads {
             for &v in q {
@@ -123,6 +126,7 @@ impl<'a> State<'a> {
                 l
             })
             .collect();
+        drop((fill, cand_nb));
         let tri: Vec<TriRecord> = (0..nt)
             .map(|t| {
                 let tri = mesh.triangles[t];
