@@ -47,7 +47,7 @@ impl State<'_> {
             while head < order.len() {
                 let x = order[head];
                 head += 1;
-                for u in self.tri[x as usize].nb {
+                for u in self.dual[x as usize] {
                     if u == NONE {
                         continue;
                     }

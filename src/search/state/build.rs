@@ -84,6 +84,9 @@ impl<'a> State<'a> {
                 false
             })
             .collect();
+        // The build's scratch goes before the initial verdicts, which set the state's peak
+        // (on corridors, where the state is all there is).
+        drop((vt_count, vt_first, has_quad));
         let mut vc_start = vec![0u32; nv + 1];
         for q in &table.quads {
             for &v in q {
@@ -123,6 +126,7 @@ impl<'a> State<'a> {
                 l
             })
             .collect();
+        drop((fill, cand_nb));
         let tri: Vec<TriRecord> = (0..nt)
             .map(|t| {
                 let tri = mesh.triangles[t];
@@ -139,7 +143,6 @@ impl<'a> State<'a> {
                 }
                 TriRecord {
                     ring: r,
-                    nb: nb[t],
                     cands: table.by_triangle[t],
                 }
             })
@@ -179,6 +182,7 @@ impl<'a> State<'a> {
             tree: Overlay::new(m, nv, nt),
             forward: false,
             initial: None,
+            building: true,
             last_local: NONE,
             last_local_mask: 0,
             stamp: vec![0; nt],
@@ -224,8 +228,9 @@ impl<'a> State<'a> {
             }
         }
         drop(acyclic);
-        // The initial verdicts are the base state: nothing to undo before it (and the log's
-        // memory, as large as every initial change, is given back).
+        // The initial verdicts are the base state: nothing to undo before it (their changes
+        // were not logged; the few unions of the boundary were).
+        st.building = false;
         st.log = Vec::new();
         st.base_cert_init = st.base_cert.len();
         st.base_cert.shrink_to_fit();

@@ -38,7 +38,7 @@
 //!   triangles the path can have changed.
 //! * **Layout.** What is read together is stored together: one 64-byte record per candidate
 //!   (quad, neighbours, pair, verdict, its version and stale mark) and one per triangle
-//!   (its ring of vertices, neighbours, candidates), so that touching an element costs one
+//!   (its ring of vertices and its candidates), so that touching an element costs one
 //!   cache line; the lockstep search, which streams through many triangles for their
 //!   neighbours only, reads the mesh's dense dual graph instead.
 //!
@@ -118,14 +118,14 @@ struct CandRecord {
 }
 const _: () = assert!(std::mem::size_of::<CandRecord>() == 64);
 
-/// Per triangle, in one record: what the searches, `apply` and the trees read about it.
+/// Per triangle, in one record: what `apply` and the trees read about it. The triangle
+/// across each side is in the state's dense `dual` (kept once: the searches stream through
+/// it).
 #[derive(Debug, Clone, Copy)]
 struct TriRecord {
     /// Its vertices, then the vertex across each of its sides (NONE without a neighbour):
     /// every vertex of every quad it can be part of.
     ring: [u32; 6],
-    /// The triangle across each side (the dual graph), or NONE.
-    nb: [u32; 3],
     /// The candidate across each side (the table's `by_triangle`), or NONE.
     cands: [u32; 3],
 }
@@ -220,7 +220,7 @@ pub struct State<'a> {
     closed: Vec<bool>,
     /// Per candidate: its quad, neighbours, pair, verdict, version, stale mark (one cache line).
     cand: Vec<CandRecord>,
-    /// Per triangle: its ring of vertices, neighbours and candidates.
+    /// Per triangle: its ring of vertices and its candidates.
     tri: Vec<TriRecord>,
     /// The candidates' dual graph as a dense array (the triangle across each side through a
     /// candidate, or NONE), which the lockstep searches stream through.
@@ -262,9 +262,14 @@ pub struct State<'a> {
     log: Vec<Op>,
     /// The look-ahead tree on top of the base state.
     tree: Overlay,
-    /// Forward mode (`set_forward`) and the initial state it resets to.
+    /// Forward mode (`set_forward`) and the initial state it resets to (none after
+    /// [`State::set_forward_uncopied`]: a single run from the state as built).
     forward: bool,
     initial: Option<Box<Initial>>,
+    /// [`State::new`] is computing the initial verdicts: nothing before them is undone, so
+    /// their changes are not logged (the log was the build's peak: 500 bytes per triangle
+    /// of a grid).
+    building: bool,
     /// The last action applied, when every verdict was exact before it and it had a local
     /// proof (its remaining neighbours stay joined around its clean vertices): what
     /// [`State::shrink_split`] needs. `NONE` otherwise.

@@ -16,6 +16,11 @@ impl State<'_> {
     /// Like [`State::apply`], but the verdicts the action may have changed are only marked;
     /// the lazy queries (and `resolve_all`) recheck them when asked. For the trees.
     pub fn apply_lazy(&mut self, c: u32) {
+        // The arena is compacted here too, not only before a recheck: the split verdicts
+        // an action keeps (`shrink_split`) append their certificates without one.
+        if self.forward && self.base_cert.len() >= self.base_cert_compact_at {
+            self.compact_base_cert();
+        }
         let ci = c as usize;
         let [t0, t1] = self.cand[ci].pair;
         assert!(
@@ -118,6 +123,11 @@ impl State<'_> {
                         self.mark(c2);
                     }
                 }
+                // A root attached stays attached until a reset; without one (no initial
+                // copy), its list is never read again.
+                if self.forward && self.initial.is_none() {
+                    self.root_watch[child as usize] = Vec::new();
+                }
             }
         }
         for i in 0..self.moved.len() {
@@ -151,7 +161,11 @@ impl State<'_> {
                     self.mark(c2);
                 }
             }
-            self.watch[x as usize] = list;
+            // Forward mode never reads a used triangle's list again before a reset; without
+            // a copy of the initial state there is none, and the list's memory goes back.
+            if !(self.forward && self.initial.is_none()) {
+                self.watch[x as usize] = list;
+            }
         }
         if !self.changed.is_empty() {
             for i in 0..self.split.len() {
@@ -236,10 +250,19 @@ impl State<'_> {
         unreachable!("undo log without an Apply marker");
     }
 
-    /// Reverts every action applied.
+    /// Reverts every action applied. Panics in forward mode without a copy of the initial
+    /// state ([`State::set_forward_uncopied`]) once an action was applied (see
+    /// [`State::can_reset`]).
     pub fn reset(&mut self) {
         assert!(self.tree.is_empty(), "reset inside a look-ahead tree");
-        if self.forward {
+        if self.forward && self.initial.is_none() {
+            // Nothing applied, nothing changed (the arena's initial certificates included).
+            assert!(
+                self.chosen.is_empty(),
+                "reset of a forward state kept without a copy of its initial state"
+            );
+            return;
+        } else if self.forward {
             self.restore_initial();
         } else {
             while !self.chosen.is_empty() {
@@ -274,6 +297,23 @@ impl State<'_> {
         }
         self.forward = on;
         self.log.clear();
+    }
+
+    /// Forward mode for one run from the state as built: as `set_forward(true)`, but no
+    /// copy of the initial state is made (about 50 bytes per triangle of a grid), so once
+    /// an action is applied the state cannot be reset: build a new one. Only at the
+    /// initial state.
+    pub fn set_forward_uncopied(&mut self) {
+        assert!(self.chosen.is_empty(), "set_forward with actions applied");
+        self.initial = None;
+        self.forward = true;
+        self.log.clear();
+    }
+
+    /// [`State::reset`] can bring the initial state back: not in forward mode without a
+    /// copy of it once an action was applied.
+    pub fn can_reset(&self) -> bool {
+        !self.forward || self.initial.is_some() || self.chosen.is_empty()
     }
 
     /// Forward mode's reset: copies the initial state back.

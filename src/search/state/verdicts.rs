@@ -132,7 +132,7 @@ impl State<'_> {
             let ib = cert[..fin].iter().position(|&t| t == b);
             let ib = ib.expect("both triangles of a pair are in the same part");
             let (lo, hi) = (ia.min(ib), ia.max(ib));
-            if off >= self.base_cert_init {
+            if off >= self.cert_floor() {
                 // Swap the pair to the end of the finished parts, then close the gap.
                 let arena = &mut self.base_cert;
                 arena.swap(off + hi, off + fin - 1);
@@ -260,7 +260,8 @@ impl State<'_> {
                     .position(|&x| x == v)
                     .expect("v is a corner");
                 // Edges at v: (tri[k], tri[k+1]) is side k, (tri[k-1], tri[k]) side k-1.
-                let (s1, s2) = (r.nb[k], r.nb[(k + 2) % 3]);
+                let nb = &self.dual[t as usize];
+                let (s1, s2) = (nb[k], nb[(k + 2) % 3]);
                 let next = if s1 != prev { s1 } else { s2 };
                 if next == NONE {
                     return false;
@@ -286,37 +287,61 @@ impl State<'_> {
     /// append a certificate per recomputed verdict; without this the arena grew with every
     /// recheck of a run (1.6 GB for greedy on a 10^6-triangle grid). Called when the arena
     /// has grown by the candidate count and twice what was kept, so the copying costs O(1)
-    /// per appended entry.
-    fn compact_base_cert(&mut self) {
+    /// per appended entry. In place: the certificates kept move down in arena order (each
+    /// verdict's certificate is its own, so none is overwritten before it moved).
+    pub(super) fn compact_base_cert(&mut self) {
         debug_assert!(self.forward, "undo logs refer to arena offsets");
-        let init = self.base_cert_init;
-        let mut kept: Vec<u32> = Vec::new();
+        let init = self.cert_floor();
+        let mut live: Vec<(u32, u32)> = Vec::new();
         for c in 0..self.cand.len() {
             let v = self.cand[c].verdict;
             if (v.cert as usize) < init || v.cert_len == 0 {
                 continue;
             }
             let [a, b] = self.cand[c].pair;
-            let v = &mut self.cand[c].verdict;
             if !self.alive[a as usize] || !self.alive[b as usize] {
                 // Never read again before a reset restores the initial verdicts.
+                let v = &mut self.cand[c].verdict;
                 (v.cert, v.cert_len) = (0, 0);
                 continue;
             }
-            let (off, len) = (v.cert as usize, v.cert_len as usize);
-            v.cert = (init + kept.len()) as u32;
-            kept.extend_from_slice(&self.base_cert[off..off + len]);
+            live.push((v.cert, c as u32));
         }
-        self.base_cert.truncate(init);
-        self.base_cert.extend_from_slice(&kept);
-        self.base_cert_compact_at = init + (2 * kept.len()).max(self.cand.len()).max(1024);
+        live.sort_unstable();
+        let mut end = init;
+        for (off, c) in live {
+            let v = &mut self.cand[c as usize].verdict;
+            let len = v.cert_len as usize;
+            self.base_cert
+                .copy_within(off as usize..off as usize + len, end);
+            v.cert = end as u32;
+            end += len;
+        }
+        self.base_cert.truncate(end);
+        self.base_cert_compact_at = init + (2 * (end - init)).max(self.cand.len()).max(1024);
+        // Give back what the arena grew past the next compaction (plus room for one
+        // action's appends): its capacity only ever grew, by doubling.
+        let room = self.base_cert_compact_at + self.base_cert_compact_at / 8;
+        self.base_cert.shrink_to(room);
+    }
+
+    /// Length of the arena's prefix that stays as it is: the initial verdicts'
+    /// certificates, which a reset brings back; none in forward mode without a copy of the
+    /// initial state (no reset), where they are compacted and edited like the others.
+    #[inline]
+    pub(super) fn cert_floor(&self) -> usize {
+        if self.forward && self.initial.is_none() {
+            0
+        } else {
+            self.base_cert_init
+        }
     }
 
     /// Logs a change of the base state for `undo`; forward mode undoes nothing and keeps
-    /// no log.
+    /// no log, nor does the build of the initial verdicts.
     #[inline]
     pub(super) fn base_log(&mut self, op: Op) {
-        if !self.forward {
+        if !self.forward && !self.building {
             self.log.push(op);
         }
     }
@@ -326,7 +351,7 @@ impl State<'_> {
     /// since recomputed (those past the initial state's, which a reset brings back).
     fn watch_push(&mut self, t: u32, c: u32, ver: u32) {
         let list = &mut self.watch[t as usize];
-        if self.forward && list.len() >= 16 && list.len().is_power_of_two() {
+        if self.forward && list.len() >= 4 && list.len().is_power_of_two() {
             let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]) as usize;
             let cand = &self.cand;
             let mut w = keep;

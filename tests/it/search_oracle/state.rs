@@ -247,6 +247,21 @@ fn forward_state_matches_oracle() {
             applies += stats.applies;
             shrinks += state.split_shrinks - before;
         }
+        // Without a copy of the initial state (a single run, as `recombine` makes): used
+        // triangles' watch lists are dropped, and the initial certificates are compacted and
+        // rewritten in place like the others.
+        let mut state = State::new(mesh, &table);
+        state.set_forward_uncopied();
+        let config = WalkConfig {
+            explorations: 0,
+            max_depth: 1,
+            unwind: false,
+        };
+        let stats = walk(name, mesh, &table, &mut state, SEED ^ 0xF9, config)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(!state.can_reset() || stats.applies == 0);
+        applies += stats.applies;
+        shrinks += state.split_shrinks;
     }
     eprintln!("forward walks: {applies} actions, {shrinks} split verdicts kept without a search");
     assert!(
