@@ -42,14 +42,19 @@ pub struct Args {
     /// Meshes (built-in names or files); default: borouchaki.
     #[arg(long = "mesh", value_name = "MESH", num_args = 1..)]
     meshes: Vec<String>,
-    /// Algorithms: selective, uniform, greedy, greedy-nocrit, optimum;
-    /// default: selective greedy greedy-nocrit optimum.
-    #[arg(long = "algo", value_name = "ALGO", num_args = 1..)]
+    /// Algorithms (see `recombine --help`): greedy-nocrit, greedy, uniform, selective,
+    /// optimum, optimistic, mcts, beam; default: selective greedy greedy-nocrit optimum.
+    #[arg(long = "algo", value_name = "ALGO", num_args = 1.., value_parser = algo_names())]
     algos: Vec<String>,
     /// Horizons of selective and uniform: a range A..B (inclusive), a list 1,3,5, or one value.
     #[arg(long, value_name = "H", default_value = "1..10", value_parser = parse_horizons)]
     horizons: Horizons,
-    /// Runs per (mesh, selective, horizon): the randomized configurations.
+    /// Node budgets per decision of optimistic, mcts and beam (one configuration each, per
+    /// horizon): a list 16,64,256 or several values.
+    #[arg(long, value_name = "B", num_args = 1.., value_delimiter = ',', default_value = "64")]
+    budgets: Vec<u32>,
+    /// Runs per (mesh, randomized method, horizon, budget): selective, optimistic, mcts,
+    /// beam.
     #[arg(long, default_value_t = 128)]
     runs: u32,
     /// Runs of each deterministic configuration: greedy and greedy-nocrit per mesh (ties are
@@ -193,6 +198,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.algos
         },
         horizons: args.horizons.0,
+        budgets: args.budgets,
         runs: args.runs,
         baseline_runs: args.baseline_runs,
         seed: args.seed,
@@ -309,6 +315,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The `--algo` values: every method of the registry (the optimum included), with its line
+/// of help.
+fn algo_names() -> clap::builder::PossibleValuesParser {
+    use quadrecomb::internals::search::methods::METHODS;
+    clap::builder::PossibleValuesParser::new(
+        METHODS
+            .iter()
+            .map(|m| clap::builder::PossibleValue::new(m.name).help(m.about)),
+    )
+}
+
 /// A configuration error worded with the flags that set the values it names.
 fn config_error(e: ConfigError) -> UsageError {
     UsageError(match e {
@@ -323,6 +340,10 @@ fn config_error(e: ConfigError) -> UsageError {
             algos.join(", ")
         ),
         ConfigError::ZeroThreads => "--threads must be at least 1".into(),
+        ConfigError::NoBudget => "--budgets: give at least one budget".into(),
+        ConfigError::BadBudget(b) => {
+            format!("--budgets {b}: each budget must be in 1..=16777216 and given once")
+        }
         ConfigError::TooLarge(SizeError::Horizons(n)) => {
             format!("{n} horizons given; a sweep takes at most {MAX_HORIZONS}")
         }

@@ -10,6 +10,7 @@
 
 mod beside_paper;
 mod box_plots;
+mod budget;
 mod compare;
 mod document;
 mod format;
