@@ -7,6 +7,7 @@
 //! A method with its parameter values is an [`Algo`], serialised as the strings records have
 //! always held (`algo`, `horizon`, and `budget` for the methods that have one).
 
+mod beam;
 mod greedy;
 mod greedy_nocrit;
 mod mcts;
@@ -28,6 +29,7 @@ pub static METHODS: &[&Info] = &[
     &optimum::INFO,
     &optimistic::INFO,
     &mcts::INFO,
+    &beam::INFO,
 ];
 
 /// The method named `name`.
