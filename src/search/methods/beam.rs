@@ -46,9 +46,11 @@ impl Policy for Beam {
         let mut nodes: Vec<Node> = Vec::new();
         let (mut beam, mut next, mut path, mut kids) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut complete: Vec<u32> = Vec::new();
         s.decide_each(|s, key, root| {
             nodes.clear();
             beam.clear();
+            complete.clear();
             // The best complete path's last node (a leaf at depth h, or one without action).
             let mut best: Option<u32> = None;
             let better = |nodes: &[Node], best: Option<u32>, i: u32| {
@@ -78,6 +80,7 @@ impl Policy for Beam {
                     let any = s.selective_children(n.key, &mut kids);
                     s.pop_n(path.len());
                     if !any {
+                        complete.push(i);
                         if better(&nodes, best, i) {
                             best = Some(i);
                         }
@@ -102,16 +105,26 @@ impl Policy for Beam {
                     break;
                 }
             }
+            complete.extend_from_slice(&beam);
             for &i in &beam {
                 if better(&nodes, best, i) {
                     best = Some(i);
                 }
             }
-            let mut j = best.expect("the root has an action");
-            while nodes[j as usize].parent != u32::MAX {
-                j = nodes[j as usize].parent;
+            // The root child (in side order, the first on ties) under which the best
+            // complete path lies.
+            let best = nodes[best.expect("the root has an action") as usize].sum;
+            let mut pick = usize::MAX;
+            for &i in complete.iter() {
+                let mut j = i as usize;
+                while nodes[j].parent != u32::MAX {
+                    j = nodes[j].parent as usize;
+                }
+                if nodes[i as usize].sum == best && j < pick {
+                    pick = j;
+                }
             }
-            nodes[j as usize].action
+            nodes[pick].action
         });
         s.state.chosen().to_vec()
     }

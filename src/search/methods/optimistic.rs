@@ -101,8 +101,8 @@ impl Policy for Optimistic {
                 let Some(Leaf(bound, Reverse(i))) = heap.pop() else {
                     break;
                 };
-                if bound <= nodes[best as usize].sum + BOUND_SLACK {
-                    break; // no leaf can beat the best path
+                if bound + BOUND_SLACK < nodes[best as usize].sum {
+                    break; // no leaf can beat the best path, nor tie with it
                 }
                 let n = nodes[i as usize];
                 path.clear();
@@ -128,11 +128,23 @@ impl Policy for Optimistic {
                     add(&mut nodes, &mut heap, &mut best, child);
                 }
             }
-            let mut j = best;
-            while nodes[j as usize].parent != u32::MAX {
-                j = nodes[j as usize].parent;
+            // The root child (in side order, the first on ties) whose subtree holds the
+            // largest sum: the first action of the best path.
+            let mut by_root = vec![f64::NEG_INFINITY; root.len()];
+            for (i, n) in nodes.iter().enumerate() {
+                let mut j = i;
+                while nodes[j].parent != u32::MAX {
+                    j = nodes[j].parent as usize;
+                }
+                by_root[j] = by_root[j].max(n.sum);
             }
-            nodes[j as usize].action
+            let mut pick = 0;
+            for (r, &v) in by_root.iter().enumerate() {
+                if v > by_root[pick] {
+                    pick = r;
+                }
+            }
+            nodes[pick].action
         });
         s.state.chosen().to_vec()
     }
