@@ -106,8 +106,9 @@ impl Policy for Mcts {
                     let ln = f64::from(n.visits.max(1)).ln();
                     let mut pick = usize::MAX;
                     let mut score = f64::NEG_INFINITY;
-                    for i in n.first as usize..(n.first + u32::from(n.len)) as usize {
-                        let ch = &t[i];
+                    let first = n.first as usize;
+                    let kids_of = &t[first..first + usize::from(n.len)];
+                    for (i, ch) in (first..).zip(kids_of) {
                         if ch.done {
                             continue;
                         }
@@ -208,8 +209,8 @@ impl Policy for Mcts {
                 (t[0].first + u32::from(t[0].len)) as usize,
             );
             let mut pick = a;
-            for i in a..b {
-                if t[i].best > t[pick].best {
+            for (i, ch) in (a..).zip(&t[a..b]) {
+                if ch.best > t[pick].best {
                     pick = i;
                 }
             }
