@@ -20,7 +20,7 @@ pub struct Args {
     #[arg(long)]
     mesh: Option<String>,
     /// Algorithm of the configuration (default: the first configuration in the report's
-    /// order: greedy-nocrit, greedy, uniform, selective, optimum).
+    /// order: greedy-nocrit, greedy, uniform, selective, optimistic, mcts, beam, optimum).
     #[arg(long)]
     algo: Option<String>,
     /// Horizon of the configuration (default: the smallest recorded).
