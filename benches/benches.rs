@@ -38,10 +38,10 @@ fn policies(c: &mut Criterion) {
         let mesh = quadrecomb::load(name).expect("built-in mesh");
         let table = CandidateTable::build(&mesh).restrict(&mesh, Rule::default());
         for (label, algo) in [
-            ("greedy-nocrit", Algo::GreedyNocrit),
-            ("greedy", Algo::Greedy),
-            ("selective h=1", Algo::Selective { horizon: 1 }),
-            ("selective h=3", Algo::Selective { horizon: 3 }),
+            ("greedy-nocrit", Algo::greedy_nocrit()),
+            ("greedy", Algo::greedy()),
+            ("selective h=1", Algo::selective(1)),
+            ("selective h=3", Algo::selective(3)),
         ] {
             let mut seed = 0u64;
             group.bench_function(format!("{name}/{label}"), |b| {

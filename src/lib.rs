@@ -16,7 +16,7 @@
 //! let table = CandidateTable::build(&mesh).restrict(&mesh, Rule::default());
 //! let best = quadrecomb::optimum(&mesh, &table);
 //! for seed in 0..4 {
-//!     let out = quadrecomb::run(&mesh, &table, Algo::Selective { horizon: 3 }, seed);
+//!     let out = quadrecomb::run(&mesh, &table, Algo::selective(3), seed);
 //!     println!(
 //!         "{} quads, {:.2} % of the optimum",
 //!         out.quads,

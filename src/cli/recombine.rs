@@ -6,17 +6,15 @@ use quadrecomb::internals::quality::{self, CandidateTable, ElementQuality, Rule}
 use quadrecomb::internals::search::{self, Algo, optimum};
 use std::process::ExitCode;
 
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-enum AlgoName {
-    /// Decreasing eta, no criterion (the paper's naive greedy).
-    #[value(name = "greedy-nocrit")]
-    GreedyNocrit,
-    /// Decreasing eta among allowed actions (uniform tree of horizon 1).
-    Greedy,
-    /// Uniform look-ahead tree (exact branch and bound).
-    Uniform,
-    /// Selective look-ahead tree.
-    Selective,
+/// The `--algo` values: every search method of the registry, with its line of help.
+pub fn algo_values() -> clap::builder::PossibleValuesParser {
+    use quadrecomb::internals::search::methods::METHODS;
+    clap::builder::PossibleValuesParser::new(
+        METHODS
+            .iter()
+            .filter(|m| m.search)
+            .map(|m| clap::builder::PossibleValue::new(m.name).help(m.about)),
+    )
 }
 
 /// Who computes eta.
@@ -36,11 +34,16 @@ pub struct Args {
     /// Mesh file (.msh) or built-in name (borouchaki, sphere).
     mesh: String,
     /// Policy.
-    #[arg(long, value_enum)]
-    algo: AlgoName,
-    /// Horizon of the uniform / selective tree (default 1; the greedy policies have none).
+    #[arg(long, value_parser = algo_values())]
+    algo: String,
+    /// Horizon of the tree policies (default 1 for uniform and selective, 10 for
+    /// optimistic and mcts, 5 for beam; the greedy policies have none).
     #[arg(long)]
     horizon: Option<u32>,
+    /// Tree nodes expanded per decision of optimistic, mcts and beam (default 64; the
+    /// others have none).
+    #[arg(long)]
+    budget: Option<u32>,
     /// Seed of the run (ChaCha8: the same seed gives the same run everywhere).
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -79,23 +82,25 @@ pub fn eta_table(
 
 /// The horizon of a tree policy; `None` for the greedy ones.
 fn horizon_of(algo: Algo) -> Option<u32> {
-    match algo {
-        Algo::GreedyNocrit | Algo::Greedy => None,
-        _ => Some(algo.horizon()),
-    }
+    algo.params().horizon
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let name = match args.algo {
-        AlgoName::GreedyNocrit => "greedy-nocrit",
-        AlgoName::Greedy => "greedy",
-        AlgoName::Uniform => "uniform",
-        AlgoName::Selective => "selective",
+    let name = args.algo.as_str();
+    let given = search::Params {
+        horizon: args.horizon,
+        budget: args.budget,
     };
-    let algo =
-        Algo::from_name(name, args.horizon.unwrap_or(1)).map_err(|e| UsageError(e.to_string()))?;
-    if args.horizon.is_some() && matches!(algo, Algo::GreedyNocrit | Algo::Greedy) {
-        eprintln!("note: --horizon is ignored: {name} looks no further than one action");
+    let algo = Algo::new(name, given).map_err(|e| UsageError(e.to_string()))?;
+    for kind in algo.ignored(given) {
+        match kind {
+            search::methods::ParamKind::Horizon => {
+                eprintln!("note: --horizon is ignored: {name} looks no further than one action")
+            }
+            search::methods::ParamKind::Budget => {
+                eprintln!("note: --budget is ignored: {name} has no node budget")
+            }
+        }
     }
     super::check_mesh_output(args.out.output.as_deref())?;
     let rule = args.rule.rule()?;
@@ -128,7 +133,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let horizon = horizon_of(algo);
     // null where the policy builds no tree (greedy-nocrit), as its sweep record has it.
-    let trees = quadrecomb::internals::experiment::record::builds_trees(algo.name());
+    let trees = algo.info().builds_trees;
     let (nodes_expanded, tree_count) = (
         trees.then_some(out.nodes_expanded),
         trees.then_some(out.trees),
@@ -155,13 +160,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             v["quality_pct"] = serde_json::json!(p);
             v["optimum"] = serde_json::json!(opt.as_ref().map(|o| o.quality));
         }
+        if let Some(b) = algo.budget() {
+            v["budget"] = serde_json::json!(b);
+        }
         println!("{v}");
     } else {
         println!("mesh            {}", args.mesh);
         println!("triangles       {nt}");
-        match horizon {
-            Some(h) => println!("algo            {} (horizon {h}, seed {})", algo, args.seed),
-            None => println!("algo            {} (seed {})", algo, args.seed),
+        match (horizon, algo.budget()) {
+            (Some(h), Some(b)) => println!(
+                "algo            {} (horizon {h}, budget {b}, seed {})",
+                algo, args.seed
+            ),
+            (Some(h), None) => {
+                println!("algo            {} (horizon {h}, seed {})", algo, args.seed)
+            }
+            _ => println!("algo            {} (seed {})", algo, args.seed),
         }
         println!("eta             {backend}");
         println!("quads           {}", out.quads);

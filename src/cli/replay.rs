@@ -20,12 +20,16 @@ pub struct Args {
     #[arg(long)]
     mesh: Option<String>,
     /// Algorithm of the configuration (default: the first configuration in the report's
-    /// order: greedy-nocrit, greedy, uniform, selective, optimum).
+    /// order: greedy-nocrit, greedy, uniform, selective, optimistic, mcts, beam, optimum).
     #[arg(long)]
     algo: Option<String>,
     /// Horizon of the configuration (default: the smallest recorded).
     #[arg(long)]
     horizon: Option<u32>,
+    /// Node budget of the configuration, for optimistic, mcts and beam (default: the
+    /// smallest recorded).
+    #[arg(long)]
+    budget: Option<u32>,
     #[command(flatten)]
     out: super::MeshOutputArgs,
     /// Print one JSON object instead of text.
@@ -59,6 +63,7 @@ fn choose_config<'r>(
         args.mesh.as_ref().is_none_or(|m| *m == c.mesh)
             && args.algo.as_ref().is_none_or(|a| *a == c.algo)
             && args.horizon.is_none_or(|h| Some(h) == c.horizon)
+            && args.budget.is_none_or(|b| Some(b) == c.budget)
     });
     if let Some((c, runs)) = found {
         return Ok((c, runs));
@@ -67,6 +72,7 @@ fn choose_config<'r>(
     asked.extend(args.mesh.as_ref().map(|m| format!("mesh {m}")));
     asked.extend(args.algo.as_ref().map(|a| format!("algorithm {a}")));
     asked.extend(args.horizon.map(|h| format!("horizon {h}")));
+    asked.extend(args.budget.map(|b| format!("budget {b}")));
     let held: Vec<String> = (results.groups.keys())
         .map(|c| format!("{} {}", c.mesh, c.label()))
         .collect();
@@ -168,6 +174,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "output": write,
         });
         super::add_element_fields(&mut v, &out.elements, rule);
+        if let Some(b) = record.budget {
+            v["budget"] = serde_json::json!(b);
+        }
         println!("{v}");
     } else {
         println!("results         {}", args.dir.display());

@@ -48,16 +48,20 @@ pub struct Args {
     /// (each can still be given), into results/suite (results/suite-<name> for the others).
     #[arg(long, value_name = "SUITE", conflicts_with = "meshes")]
     suite: Option<String>,
-    /// Algorithms: selective, uniform, greedy, greedy-nocrit, optimum;
-    /// default: selective greedy greedy-nocrit optimum.
-    #[arg(long = "algo", value_name = "ALGO", num_args = 1..)]
+    /// Algorithms (see `recombine --help`): greedy-nocrit, greedy, uniform, selective,
+    /// optimum, optimistic, mcts, beam; default: selective greedy greedy-nocrit optimum.
+    #[arg(long = "algo", value_name = "ALGO", num_args = 1.., value_parser = algo_names())]
     algos: Vec<String>,
-    /// Horizons of selective and uniform: a range A..B (inclusive), a list 1,3,5, or one value
-    /// [default: 1..10; with --suite, 1,3,5].
+    /// Horizons of selective, uniform and the budgeted methods: a range A..B (inclusive), a
+    /// list 1,3,5, or one value [default: 1..10; with --suite, 1,3,5].
     #[arg(long, value_name = "H", value_parser = parse_horizons)]
     horizons: Option<Horizons>,
-    /// Runs per (mesh, selective, horizon): the randomized configurations [default: 128; with
-    /// --suite, 32].
+    /// Node budgets per decision of optimistic, mcts and beam (one configuration each, per
+    /// horizon): a list 16,64,256 or several values.
+    #[arg(long, value_name = "B", num_args = 1.., value_delimiter = ',', default_value = "64")]
+    budgets: Vec<u32>,
+    /// Runs per (mesh, randomized method, horizon, budget): selective, optimistic, mcts,
+    /// beam [default: 128; with --suite, 32].
     #[arg(long)]
     runs: Option<u32>,
     /// Runs of each deterministic configuration: greedy and greedy-nocrit per mesh (ties are
@@ -213,6 +217,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.algos
         },
         horizons: args.horizons.map_or(paper.horizons.clone(), |h| h.0),
+        budgets: args.budgets,
         runs: args.runs.unwrap_or(paper.runs),
         baseline_runs: args.baseline_runs,
         seed: args.seed,
@@ -423,6 +428,17 @@ fn suite_request(name: &str) -> Result<SweepRequest, UsageError> {
     })
 }
 
+/// The `--algo` values: every method of the registry (the optimum included), with its line
+/// of help.
+fn algo_names() -> clap::builder::PossibleValuesParser {
+    use quadrecomb::internals::search::methods::METHODS;
+    clap::builder::PossibleValuesParser::new(
+        METHODS
+            .iter()
+            .map(|m| clap::builder::PossibleValue::new(m.name).help(m.about)),
+    )
+}
+
 /// A configuration error worded with the flags that set the values it names.
 fn config_error(e: ConfigError) -> UsageError {
     UsageError(match e {
@@ -437,6 +453,10 @@ fn config_error(e: ConfigError) -> UsageError {
             algos.join(", ")
         ),
         ConfigError::ZeroThreads => "--threads must be at least 1".into(),
+        ConfigError::NoBudget => "--budgets: give at least one budget".into(),
+        ConfigError::BadBudget(b) => {
+            format!("--budgets {b}: each budget must be in 1..=16777216 and given once")
+        }
         ConfigError::TooLarge(SizeError::Horizons(n)) => {
             format!("{n} horizons given; a sweep takes at most {MAX_HORIZONS}")
         }

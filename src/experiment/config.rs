@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use super::engine::EngineOptions;
 use super::manifest::{MeshEntry, Shard, SweepSpec};
-use super::plan::{has_horizon, planned_runs};
-use super::record::ALGO_NAMES;
+use super::plan::{has_budget, has_horizon, planned_runs};
+use super::record::algo_names;
 use crate::gpu::Backend;
 use crate::quality::Rule;
 
@@ -30,11 +30,14 @@ pub const MAX_RUNS: u64 = 10_000_000;
 pub struct SweepRequest {
     /// Meshes: built-in names or paths; at least one.
     pub meshes: Vec<String>,
-    /// Algorithm names, each one of [`ALGO_NAMES`] and given once; at least one.
+    /// Algorithm names, each one of [`algo_names`] and given once; at least one.
     pub algos: Vec<String>,
     /// Horizons of `uniform` and `selective`: each at least 1 and given once, at most
     /// [`MAX_HORIZONS`]; at least one when a tree algorithm is asked for.
     pub horizons: Vec<u32>,
+    /// Node budgets per decision of the methods with one (optimistic, mcts, beam): each in
+    /// the registry's range and given once; at least one when such a method is asked for.
+    pub budgets: Vec<u32>,
     /// Runs per (mesh, tree algorithm, horizon): at least 1 when a tree algorithm is asked
     /// for, and the whole sweep at most [`MAX_RUNS`] runs.
     pub runs: u32,
@@ -71,6 +74,7 @@ impl Default for SweepRequest {
             meshes: vec!["borouchaki".into()],
             algos: DEFAULT_ALGOS.iter().map(|s| s.to_string()).collect(),
             horizons: (1..=10).collect(),
+            budgets: vec![crate::search::methods::BUDGET.default],
             runs: 128,
             baseline_runs: 1,
             seed: DEFAULT_SEED,
@@ -95,8 +99,8 @@ pub enum ConfigError {
     /// The algorithm list is empty.
     #[error("no algorithm given")]
     NoAlgorithm,
-    /// An algorithm name is not one of [`ALGO_NAMES`].
-    #[error("unknown algorithm {0:?} (expected one of {names})", names = ALGO_NAMES.join(", "))]
+    /// An algorithm name is not one of [`algo_names`].
+    #[error("unknown algorithm {0:?} (expected one of {names})", names = algo_names().join(", "))]
     UnknownAlgorithm(String),
     /// An algorithm is listed twice.
     #[error("algorithm {0:?} given twice")]
@@ -119,6 +123,12 @@ pub enum ConfigError {
     /// Zero worker threads.
     #[error("the worker threads must be at least 1")]
     ZeroThreads,
+    /// A method with a node budget is asked for without any budget.
+    #[error("no budget given for the methods with a node budget")]
+    NoBudget,
+    /// A budget is out of range or given twice.
+    #[error("budget {0} is out of range (1..=16777216) or given twice")]
+    BadBudget(u32),
     /// A base seed above 2^53 - 1, which JSON readers that hold numbers as doubles (jq,
     /// pandas with pyarrow) would read as another seed.
     #[error(
@@ -161,13 +171,14 @@ pub fn check_size(
     meshes: usize,
     algos: &[String],
     horizons: usize,
+    budgets: usize,
     runs: u32,
     baseline_runs: u32,
 ) -> Result<(), SizeError> {
     if horizons > MAX_HORIZONS {
         return Err(SizeError::Horizons(horizons));
     }
-    let total = planned_runs(meshes, algos, horizons, runs, baseline_runs);
+    let total = planned_runs(meshes, algos, horizons, budgets, runs, baseline_runs);
     if total > MAX_RUNS {
         return Err(SizeError::Runs {
             total,
@@ -197,7 +208,7 @@ impl SweepConfig {
             return Err(ConfigError::NoAlgorithm);
         }
         for (i, a) in r.algos.iter().enumerate() {
-            if !ALGO_NAMES.contains(&a.as_str()) {
+            if !algo_names().contains(&a.as_str()) {
                 return Err(ConfigError::UnknownAlgorithm(a.clone()));
             }
             if r.algos[..i].contains(a) {
@@ -232,6 +243,17 @@ impl SweepConfig {
                 return Err(ConfigError::DuplicateHorizon(*h));
             }
         }
+        if r.algos.iter().any(|a| has_budget(a)) {
+            if r.budgets.is_empty() {
+                return Err(ConfigError::NoBudget);
+            }
+            let range = crate::search::methods::BUDGET;
+            for (i, b) in r.budgets.iter().enumerate() {
+                if *b < range.min || *b > range.max || r.budgets[..i].contains(b) {
+                    return Err(ConfigError::BadBudget(*b));
+                }
+            }
+        }
         if r.threads == 0 {
             return Err(ConfigError::ZeroThreads);
         }
@@ -239,6 +261,7 @@ impl SweepConfig {
             r.meshes.len(),
             &r.algos,
             r.horizons.len(),
+            r.budgets.len(),
             r.runs,
             r.baseline_runs,
         )?;
@@ -329,6 +352,11 @@ impl SweepConfig {
             algos: c.algos.clone(),
             horizons: if c.algos.iter().any(|a| has_horizon(a)) {
                 c.horizons.clone()
+            } else {
+                Vec::new()
+            },
+            budgets: if c.algos.iter().any(|a| has_budget(a)) {
+                c.budgets.clone()
             } else {
                 Vec::new()
             },

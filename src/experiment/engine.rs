@@ -81,6 +81,7 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
         triangles: mesh.triangles,
         algo: job.algo.clone(),
         horizon: job.horizon,
+        budget: job.budget,
         seed: job.seed,
         run: job.run,
         quads: out.quads,
@@ -197,13 +198,19 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             r.min_eta, r.allow_invalid
         ));
     }
-    if !super::record::ALGO_NAMES.contains(&r.algo.as_str()) {
+    if !super::record::algo_names().contains(&r.algo.as_str()) {
         return Err(format!("unknown algorithm {:?}", r.algo));
     }
     if super::plan::has_horizon(&r.algo) != r.horizon.is_some() || r.horizon == Some(0) {
         return Err(format!(
             "horizon {:?} does not fit algorithm {}",
             r.horizon, r.algo
+        ));
+    }
+    if super::plan::has_budget(&r.algo) != r.budget.is_some() || r.budget == Some(0) {
+        return Err(format!(
+            "budget {:?} does not fit algorithm {}",
+            r.budget, r.algo
         ));
     }
     if 2 * r.quads as u128 + r.triangles_left as u128 != r.triangles as u128 {

@@ -205,6 +205,7 @@ pub(crate) mod tests {
                 mesh: 0,
                 algo: "selective".into(),
                 horizon: Some(1 + run % 3),
+                budget: None,
                 run,
                 seed: u64::from(run) * 7919,
             })

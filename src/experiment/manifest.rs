@@ -66,6 +66,10 @@ pub struct SweepSpec {
     /// times.
     #[serde(default = "plan_version_1")]
     pub plan_version: u32,
+    /// Node budgets per decision of the methods with one (optimistic, mcts, beam); absent
+    /// when no such method is swept.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub budgets: Vec<u32>,
 }
 
 /// The plan version of manifests written before the field existed.
@@ -241,6 +245,7 @@ impl Manifest {
             s.meshes.len(),
             &s.algos,
             s.horizons.len(),
+            s.budgets.len(),
             s.runs,
             s.baseline_runs,
         );
@@ -391,6 +396,11 @@ pub fn union_spec(a: &SweepSpec, b: &SweepSpec) -> SweepSpec {
             u.horizons.push(*h);
         }
     }
+    for x in &b.budgets {
+        if !u.budgets.contains(x) {
+            u.budgets.push(*x);
+        }
+    }
     u.runs = match (uses_runs(a), uses_runs(b)) {
         (true, true) => a.runs.max(b.runs),
         (false, true) => b.runs,
@@ -421,6 +431,9 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     }
     if a.horizons != b.horizons {
         return Some(format!("horizons {:?} vs {:?}", a.horizons, b.horizons));
+    }
+    if a.budgets != b.budgets {
+        return Some(format!("budgets {:?} vs {:?}", a.budgets, b.budgets));
     }
     if a.runs != b.runs {
         return Some(format!("runs {} vs {}", a.runs, b.runs));

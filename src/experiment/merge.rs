@@ -105,6 +105,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
         spec.meshes.len(),
         &spec.algos,
         spec.horizons.len(),
+        spec.budgets.len(),
         spec.runs,
         spec.baseline_runs,
     )

@@ -4,41 +4,50 @@ use super::manifest::{Shard, SweepSpec};
 use super::record::RunKey;
 use super::seed::derive_seed;
 
-/// Algorithms with a look-ahead horizon.
+use crate::search::methods::{self, ParamKind};
+
+/// Algorithms with a look-ahead horizon (the registry's methods with a horizon parameter).
 pub fn has_horizon(algo: &str) -> bool {
-    matches!(algo, "uniform" | "selective")
+    methods::find(algo).is_some_and(|m| m.has(ParamKind::Horizon))
+}
+
+/// Algorithms with a node budget per decision (one configuration per `budgets` entry).
+pub fn has_budget(algo: &str) -> bool {
+    methods::find(algo).is_some_and(|m| m.has(ParamKind::Budget))
 }
 
 /// Algorithms that draw nothing at random and run `baseline_runs` times (plan version 2):
-/// every run of one configuration is the same run (greedy and greedy-nocrit break ties by
-/// index, the uniform tree branches on every action). The optimum, exact, runs once.
+/// every run of one configuration is the same run (the registry's searches that are not
+/// random: greedy and greedy-nocrit break ties by index, the uniform tree branches on every
+/// action). The optimum, exact and no search, runs once.
 pub fn runs_as_baseline(algo: &str) -> bool {
-    matches!(algo, "greedy" | "greedy-nocrit" | "uniform")
+    methods::find(algo).is_some_and(|m| m.search && !m.random)
 }
 
-/// Whether `spec`'s run list uses its `runs` (a randomized tree algorithm: `selective`, and
-/// `uniform` in plan version 1).
+/// Plan version 1 ran the uniform tree `runs` times per horizon, as if it were random.
+fn random_in(algo: &str, version: u32) -> bool {
+    methods::find(algo).is_some_and(|m| m.random) || (algo == "uniform" && version < 2)
+}
+
+/// Whether `spec`'s run list uses its `runs` (a randomized tree algorithm: `selective` and
+/// the budgeted policies, and `uniform` in plan version 1).
 pub fn uses_runs(spec: &SweepSpec) -> bool {
-    spec.algos
-        .iter()
-        .any(|a| a == "selective" || (a == "uniform" && spec.plan_version < 2))
+    spec.algos.iter().any(|a| random_in(a, spec.plan_version))
 }
 
 /// Whether `spec`'s run list uses its `baseline_runs` (a deterministic configuration other
 /// than the optimum).
 pub fn uses_baseline_runs(spec: &SweepSpec) -> bool {
-    spec.algos.iter().any(|a| {
-        matches!(a.as_str(), "greedy" | "greedy-nocrit")
-            || (a == "uniform" && spec.plan_version >= 2)
-    })
+    spec.algos
+        .iter()
+        .any(|a| runs_as_baseline(a) && !random_in(a, spec.plan_version))
 }
 
-/// Runs per configuration of `algo` (per horizon for the trees) under plan `version`.
+/// Runs per configuration of `algo` (per horizon and budget) under plan `version`.
 fn runs_of(algo: &str, version: u32, runs: u32, baseline_runs: u32) -> u32 {
-    match algo {
-        "optimum" => 1,
-        "uniform" if version >= 2 => baseline_runs,
-        a if has_horizon(a) => runs,
+    match methods::find(algo) {
+        Some(m) if !m.search => 1,
+        _ if random_in(algo, version) => runs,
         _ => baseline_runs,
     }
 }
@@ -50,8 +59,10 @@ pub struct Job {
     pub mesh: usize,
     /// Algorithm name.
     pub algo: String,
-    /// Horizon, for `uniform` and `selective`.
+    /// Horizon, for the methods with one.
     pub horizon: Option<u32>,
+    /// Nodes per decision, for the methods with a budget.
+    pub budget: Option<u32>,
     /// Run index within the configuration.
     pub run: u32,
     /// The derived seed.
@@ -65,6 +76,7 @@ impl Job {
             mesh: spec.meshes[self.mesh].name.clone(),
             algo: self.algo.clone(),
             horizon: self.horizon,
+            budget: self.budget,
             run: self.run,
         }
     }
@@ -76,6 +88,7 @@ pub fn planned_runs(
     meshes: usize,
     algos: &[String],
     horizons: usize,
+    budgets: usize,
     runs: u32,
     baseline_runs: u32,
 ) -> u64 {
@@ -83,19 +96,21 @@ pub fn planned_runs(
     let per_mesh = algos
         .iter()
         .map(|a| {
-            let n = u64::from(runs_of(a, version, runs, baseline_runs));
+            let mut n = u64::from(runs_of(a, version, runs, baseline_runs));
             if has_horizon(a) {
-                (horizons as u64).saturating_mul(n)
-            } else {
-                n
+                n = (horizons as u64).saturating_mul(n);
             }
+            if has_budget(a) {
+                n = (budgets as u64).saturating_mul(n);
+            }
+            n
         })
         .fold(0u64, u64::saturating_add);
     per_mesh.saturating_mul(meshes as u64)
 }
 
 /// Every run of a sweep, in canonical order: by mesh, then algorithm (spec order), then
-/// horizon, then run index. `optimum` is one run per mesh; `greedy` and `greedy-nocrit` are
+/// horizon, then budget, then run index. `optimum` is one run per mesh; `greedy` and `greedy-nocrit` are
 /// `baseline_runs` runs; `selective` is `runs` runs per horizon; `uniform`, deterministic, is
 /// `baseline_runs` runs per horizon (plan version 2; `runs` in version 1).
 pub fn plan(spec: &SweepSpec) -> Vec<Job> {
@@ -108,22 +123,36 @@ pub fn plan(spec: &SweepSpec) -> Vec<Job> {
             } else {
                 vec![None]
             };
+            let budgets: Vec<Option<u32>> = if has_budget(algo) {
+                spec.budgets.iter().map(|&b| Some(b)).collect()
+            } else {
+                vec![None]
+            };
             for horizon in horizons {
-                for run in 0..runs {
-                    jobs.push(Job {
-                        mesh: m,
-                        algo: algo.clone(),
-                        horizon,
-                        run,
-                        seed: derive_seed(
-                            spec.plan_version,
-                            spec.seed,
-                            &mesh.hash,
-                            algo,
+                for &budget in &budgets {
+                    // A budget enters the seed as part of the name ("mcts b=64"), so that
+                    // the configurations without one keep their seeds.
+                    let named = match budget {
+                        Some(b) => format!("{algo} b={b}"),
+                        None => algo.clone(),
+                    };
+                    for run in 0..runs {
+                        jobs.push(Job {
+                            mesh: m,
+                            algo: algo.clone(),
                             horizon,
+                            budget,
                             run,
-                        ),
-                    });
+                            seed: derive_seed(
+                                spec.plan_version,
+                                spec.seed,
+                                &mesh.hash,
+                                &named,
+                                horizon,
+                                run,
+                            ),
+                        });
+                    }
                 }
             }
         }
@@ -196,6 +225,7 @@ pub(crate) mod tests {
             min_eta: 0.0,
             allow_invalid: false,
             plan_version: crate::experiment::seed::PLAN_VERSION,
+            budgets: Vec::new(),
         }
     }
 
@@ -208,7 +238,7 @@ pub(crate) mod tests {
         assert_eq!(count(&s, "uniform"), 2 * 3 * 2);
         assert_eq!(count(&s, "selective"), 2 * 3 * 5);
         assert_eq!(
-            planned_runs(2, &s.algos, 3, s.runs, s.baseline_runs),
+            planned_runs(2, &s.algos, 3, 0, s.runs, s.baseline_runs),
             plan(&s).len() as u64
         );
         // Version 1 (older manifests) keeps its run list, so those sweeps still resume.

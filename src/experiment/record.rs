@@ -6,8 +6,11 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The algorithm names a record's `algo` field takes.
-pub const ALGO_NAMES: &[&str] = &["greedy-nocrit", "greedy", "uniform", "selective", "optimum"];
+/// The algorithm names a record's `algo` field takes: the registry's
+/// ([`crate::search::methods::METHODS`]).
+pub fn algo_names() -> Vec<&'static str> {
+    crate::search::methods::names().collect()
+}
 
 /// The result of one run of one algorithm on one mesh.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -18,10 +21,15 @@ pub struct RunRecord {
     pub mesh_hash: String,
     /// Number of triangles of the input mesh.
     pub triangles: usize,
-    /// "greedy-nocrit", "greedy", "uniform", "selective" or "optimum".
+    /// A method's name ([`algo_names`]: "greedy-nocrit", "greedy", "uniform", "selective",
+    /// "optimum", "optimistic", "mcts", "beam").
     pub algo: String,
-    /// Look-ahead horizon of `uniform` and `selective`; `None` for the others.
+    /// Look-ahead horizon of the methods with one; `None` for the others.
     pub horizon: Option<u32>,
+    /// Tree nodes per decision of the methods with a budget (optimistic, mcts, beam);
+    /// absent for the others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget: Option<u32>,
     /// The per-run seed given to the search, derived by [`super::seed::derive_seed`].
     pub seed: u64,
     /// Index of the run within its (mesh, algo, horizon) configuration, from 0.
@@ -87,7 +95,19 @@ pub struct RunRecord {
 /// `nodes_expanded` and `trees` apply: not "greedy-nocrit" (no criterion, no tree) nor
 /// "optimum" (a matching), whose records hold null there, as `optimum --json` does.
 pub fn builds_trees(algo: &str) -> bool {
-    !matches!(algo, "greedy-nocrit" | "optimum")
+    crate::search::methods::find(algo).is_some_and(|m| m.builds_trees)
+}
+
+pub use crate::search::methods::{Params, label};
+
+/// A method's place in the reports' order (the registry's rank; unknown names last).
+pub fn algo_rank(algo: &str) -> u8 {
+    crate::search::methods::find(algo).map_or(u8::MAX, |m| m.rank)
+}
+
+/// Whether `algo` is a search run per seed (not the optimum, solved once per mesh).
+pub fn is_search(algo: &str) -> bool {
+    crate::search::methods::find(algo).is_some_and(|m| m.search)
 }
 
 /// What a field that records the rule reads when absent: the rule of every record and
@@ -113,6 +133,9 @@ pub struct RunKey {
     pub algo: String,
     /// Horizon, for tree policies.
     pub horizon: Option<u32>,
+    /// Budget, for the budgeted policies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget: Option<u32>,
     /// Run index.
     pub run: u32,
 }
@@ -122,6 +145,9 @@ impl std::fmt::Display for RunKey {
         write!(f, "{} {}", self.mesh, self.algo)?;
         if let Some(h) = self.horizon {
             write!(f, " h={h}")?;
+        }
+        if let Some(b) = self.budget {
+            write!(f, " b={b}")?;
         }
         write!(f, " run {}", self.run)
     }
@@ -134,6 +160,7 @@ impl RunRecord {
             mesh: self.mesh.clone(),
             algo: self.algo.clone(),
             horizon: self.horizon,
+            budget: self.budget,
             run: self.run,
         }
     }

@@ -207,9 +207,12 @@ impl<'m> Replayer<'m> {
 
     /// Re-runs `record` on its mesh with the sweep's eta and rule, from its seed.
     pub fn replay(&mut self, record: &RunRecord) -> Result<Replayed<'_>, ReplayError> {
-        let algo = (record.algo != "optimum")
-            .then(|| Algo::from_name(&record.algo, record.horizon.unwrap_or(1)))
-            .transpose()
+        let given = search::Params {
+            horizon: record.horizon,
+            budget: record.budget,
+        };
+        let algo = Algo::of_record(&record.algo, given)
+            .map(|a| a.info().search.then_some(a))
             .map_err(|e| ReplayError::Algo {
                 algo: record.algo.clone(),
                 why: e.to_string(),

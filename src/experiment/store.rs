@@ -137,6 +137,7 @@ pub(crate) mod tests {
             triangles: 100,
             algo: "selective".into(),
             horizon: Some(2),
+            budget: None,
             seed: 42 + u64::from(run),
             run,
             quads: 48,

@@ -44,6 +44,9 @@ pub struct Group {
     pub algo: String,
     /// Horizon, for tree policies.
     pub horizon: Option<u32>,
+    /// Node budget per decision, for the budgeted policies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget: Option<u32>,
     /// Runs in the group.
     pub n: usize,
     /// Quality as % of the optimum (`None` when no run knows the optimum).
@@ -97,15 +100,16 @@ pub struct Summary {
 
 /// Computes the summary of a set of records.
 pub fn summarize(records: &[RunRecord]) -> Summary {
-    let mut by: BTreeMap<(String, String, Option<u32>), Vec<&RunRecord>> = BTreeMap::new();
+    type Key = (String, String, Option<u32>, Option<u32>);
+    let mut by: BTreeMap<Key, Vec<&RunRecord>> = BTreeMap::new();
     for r in records {
-        by.entry((r.mesh.clone(), r.algo.clone(), r.horizon))
+        by.entry((r.mesh.clone(), r.algo.clone(), r.horizon, r.budget))
             .or_default()
             .push(r);
     }
     let groups: Vec<Group> = by
         .into_iter()
-        .map(|((mesh, algo, horizon), rs)| {
+        .map(|((mesh, algo, horizon, budget), rs)| {
             let col = |f: &dyn Fn(&RunRecord) -> Option<f64>| -> Vec<f64> {
                 rs.iter()
                     .filter_map(|r| f(r))
@@ -117,6 +121,7 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
                 mesh,
                 algo,
                 horizon,
+                budget,
                 n: rs.len(),
                 quality_pct: BoxStats::of(&col(&|r| r.quality_pct)),
                 recombined_pct: BoxStats::of(&col(&|r| Some(r.recombined_pct))),
@@ -137,7 +142,7 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
         .collect();
     let mut curves: BTreeMap<(String, String), Vec<(u32, f64)>> = BTreeMap::new();
     for g in &groups {
-        if let (Some(h), Some(t)) = (g.horizon, &g.time_s) {
+        if let (Some(h), Some(t), None) = (g.horizon, &g.time_s, g.budget) {
             curves
                 .entry((g.mesh.clone(), g.algo.clone()))
                 .or_default()
@@ -184,13 +189,22 @@ impl Group {
 
 /// The CSV text of a summary (see the module docs for the columns).
 pub fn to_csv(summary: &Summary) -> String {
-    let mut out = String::from(
-        "mesh,algo,horizon,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers\n",
-    );
+    // The budget column only where a group has a budget: summaries without one read as
+    // they always did.
+    let budgets = summary.groups.iter().any(|g| g.budget.is_some());
+    let mut out = String::from(if budgets {
+        "mesh,algo,horizon,budget,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers\n"
+    } else {
+        "mesh,algo,horizon,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers\n"
+    });
     for g in &summary.groups {
         for &metric in METRICS {
             if let Some(b) = g.metric(metric) {
-                let h = g.horizon.map(|h| h.to_string()).unwrap_or_default();
+                let mut h = g.horizon.map(|h| h.to_string()).unwrap_or_default();
+                if budgets {
+                    h.push(',');
+                    h.push_str(&g.budget.map(|b| b.to_string()).unwrap_or_default());
+                }
                 out.push_str(&format!(
                     "{},{},{h},{metric},{},{},{},{},{},{},{},{},{},{},{}\n",
                     csv_field(&g.mesh),

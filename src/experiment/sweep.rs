@@ -283,11 +283,15 @@ impl WorkerFactory for SearchFactory<'_> {
 
 impl Worker for SearchWorker<'_> {
     fn run(&mut self, job: &Job) -> Result<Outcome, ExperimentError> {
-        if job.algo == "optimum" {
+        let given = crate::search::Params {
+            horizon: job.horizon,
+            budget: job.budget,
+        };
+        let algo = Algo::of_record(&job.algo, given)
+            .map_err(|e| ExperimentError::Invalid(e.to_string()))?;
+        if !algo.info().search {
             return Ok(Outcome::of_optimum(&self.factory.optimum[job.mesh]));
         }
-        let algo = Algo::from_name(&job.algo, job.horizon.unwrap_or(1))
-            .map_err(|e| ExperimentError::Invalid(e.to_string()))?;
         let f = self.factory;
         let searcher = self.searchers[job.mesh]
             .get_or_insert_with(|| Searcher::new(&f.meshes[job.mesh], &f.tables[job.mesh]));

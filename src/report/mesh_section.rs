@@ -30,7 +30,10 @@ fn config_rows(
     (configs.iter())
         .map(|(c, runs)| {
             let mut row = vec![
-                c.algo.clone(),
+                match c.budget {
+                    Some(b) => format!("{} b={b}", c.algo),
+                    None => c.algo.clone(),
+                },
                 c.horizon.map_or("–".into(), |h| h.to_string()),
             ];
             row.extend(cells(c, runs));
@@ -48,8 +51,18 @@ pub(super) fn mesh_section(
     seed: u64,
     replayer: &mut Replayer<'_>,
 ) -> Result<(), ReportError> {
-    let configs: Vec<(&Config, &[Run])> = results.configs_of(mesh).collect();
-    let first = &configs[0].1[0];
+    let every: Vec<(&Config, &[Run])> = results.configs_of(mesh).collect();
+    let first = &every[0].1[0];
+    // The budgeted configurations have their own section (quality against budget); the
+    // horizon sections below read the others.
+    let configs: Vec<(&Config, &[Run])> = (every.iter().copied())
+        .filter(|(c, _)| c.budget.is_none())
+        .collect();
+    let configs = if configs.is_empty() {
+        every.clone()
+    } else {
+        configs
+    };
     doc.heading(2, format!("Mesh {mesh}"));
     let opt = optimum_of(results, mesh);
     doc.para(format!(
@@ -121,6 +134,7 @@ pub(super) fn mesh_section(
         doc.para("Nothing to compare: no two horizons of one algorithm and no greedy runs.");
     }
     family_blocks(doc, &families);
+    super::budget::budget_section(doc, summary, mesh, &every, seed)?;
     Ok(())
 }
 

@@ -11,6 +11,7 @@
 mod across;
 mod beside_paper;
 mod box_plots;
+mod budget;
 mod cd_diagram;
 mod compare;
 mod document;

@@ -27,6 +27,8 @@ pub struct Config {
     pub algo: String,
     /// Horizon, if the algorithm has one.
     pub horizon: Option<u32>,
+    /// Node budget per decision, if the algorithm has one.
+    pub budget: Option<u32>,
 }
 
 impl Config {
@@ -37,29 +39,26 @@ impl Config {
             algo_rank: algo_rank(&run.algo),
             algo: run.algo.clone(),
             horizon: run.horizon,
+            budget: run.budget,
         }
     }
 
-    /// "selective h=3", "greedy".
+    /// "selective h=3", "mcts h=10 b=64", "greedy".
     pub fn label(&self) -> String {
-        match self.horizon {
-            Some(h) => format!("{} h={h}", self.algo),
-            None => self.algo.clone(),
-        }
+        crate::experiment::record::label(
+            &self.algo,
+            crate::experiment::record::Params {
+                horizon: self.horizon,
+                budget: self.budget,
+            },
+        )
     }
 }
 
-/// Order of algorithms in tables: baselines first, then uniform, selective, the optimum,
-/// unknown names.
+/// Order of algorithms in tables: the registry's ranks (baselines first, then uniform,
+/// selective, the budgeted policies, the optimum), unknown names last.
 fn algo_rank(algo: &str) -> u8 {
-    match algo {
-        "greedy-nocrit" => 0,
-        "greedy" => 1,
-        "uniform" => 2,
-        "selective" => 3,
-        "optimum" => 4,
-        _ => 5,
-    }
+    crate::experiment::record::algo_rank(algo)
 }
 
 /// The runs of one results directory, grouped by configuration.

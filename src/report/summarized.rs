@@ -8,7 +8,9 @@ use crate::stats::describe::BoxStats;
 
 /// The summary's group of configuration `c`.
 fn group<'s>(summary: &'s Summary, c: &Config) -> Option<&'s Group> {
-    (summary.groups.iter()).find(|g| g.mesh == c.mesh && g.algo == c.algo && g.horizon == c.horizon)
+    (summary.groups.iter()).find(|g| {
+        g.mesh == c.mesh && g.algo == c.algo && g.horizon == c.horizon && g.budget == c.budget
+    })
 }
 
 /// The median of a summarized field of `c`, when every run of `c` has it.

@@ -37,7 +37,7 @@ pub fn rerun<'a>(replayer: &'a mut Replayer<'_>, run: &Run) -> Result<Typical<'a
         )
     };
     // The optimum has no seed to re-run from: its matching is computed again.
-    if run.algo == "optimum" {
+    if !crate::experiment::record::is_search(&run.algo) {
         let note = format!(
             "optimum (maximum-weight matching): {} quads, {} triangles left, quality {:.4}. \
              Matching computed again with eta from {}; {verdict}.",

@@ -1,5 +1,5 @@
 //! Searches over recombination sequences: the state with undo, the polder criterion, the
-//! greedy / uniform / selective policies, and the exact optimum. Imports `mesh` and the
+//! policies (one registry: [`methods`]), and the exact optimum. Imports `mesh` and the
 //! candidate table only.
 //!
 //! ```no_run
@@ -9,15 +9,18 @@
 //! let table = CandidateTable::build(&mesh);
 //! let mut searcher = Searcher::new(&mesh, &table);
 //! for seed in 0..4 {
-//!     let out = searcher.run(Algo::Selective { horizon: 3 }, seed);
+//!     let out = searcher.run(Algo::selective(3), seed);
 //!     println!("{} quads, quality {:.2}", out.quads, out.quality);
 //! }
 //! # Ok(()) }
 //! ```
 
+pub mod methods;
 pub mod optimum;
 mod policy;
 pub mod state;
+
+pub use methods::{Algo, AlgoError, Params};
 
 use crate::mesh::Mesh;
 use crate::quality::CandidateTable;
@@ -25,95 +28,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use state::State;
 use std::fmt;
-use std::str::FromStr;
 use std::time::Instant;
-
-/// A recombination policy.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Algo {
-    /// Recombine in decreasing eta, ignoring the criterion (the paper's "naive greedy").
-    GreedyNocrit,
-    /// Decreasing eta among the allowed actions (= uniform tree of horizon 1).
-    Greedy,
-    /// Uniform look-ahead tree (section 4): first action of the best `horizon`-action
-    /// sequence, found by exact branch and bound.
-    Uniform { horizon: u32 },
-    /// Selective look-ahead tree (section 5).
-    Selective { horizon: u32 },
-}
-
-impl Algo {
-    /// Every policy name, as accepted by [`FromStr`].
-    pub const NAMES: [&'static str; 4] = ["greedy-nocrit", "greedy", "uniform", "selective"];
-
-    /// The policy's name ("greedy-nocrit", "greedy", "uniform", "selective").
-    pub fn name(&self) -> &'static str {
-        match self {
-            Algo::GreedyNocrit => "greedy-nocrit",
-            Algo::Greedy => "greedy",
-            Algo::Uniform { .. } => "uniform",
-            Algo::Selective { .. } => "selective",
-        }
-    }
-
-    /// The horizon of a tree policy; 1 for greedy (a tree of horizon 1), 0 for greedy-nocrit.
-    pub fn horizon(&self) -> u32 {
-        match *self {
-            Algo::GreedyNocrit => 0,
-            Algo::Greedy => 1,
-            Algo::Uniform { horizon } | Algo::Selective { horizon } => horizon,
-        }
-    }
-
-    /// The policy named `name` with `horizon` (ignored by the greedy policies). Horizon must
-    /// be at least 1.
-    pub fn from_name(name: &str, horizon: u32) -> Result<Algo, AlgoError> {
-        if horizon == 0 && matches!(name, "uniform" | "selective") {
-            return Err(AlgoError::ZeroHorizon);
-        }
-        Ok(match name {
-            "greedy-nocrit" => Algo::GreedyNocrit,
-            "greedy" => Algo::Greedy,
-            "uniform" => Algo::Uniform { horizon },
-            "selective" => Algo::Selective { horizon },
-            _ => return Err(AlgoError::Unknown(name.to_string())),
-        })
-    }
-}
-
-/// The policy's name (the horizon is not part of it; see [`Algo::horizon`]).
-impl fmt::Display for Algo {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// Parses a policy name, optionally with a horizon: `selective` (horizon 1), `selective:5`.
-impl FromStr for Algo {
-    type Err = AlgoError;
-    fn from_str(s: &str) -> Result<Algo, AlgoError> {
-        match s.split_once(':') {
-            Some((name, h)) => {
-                let h = h
-                    .parse()
-                    .map_err(|_| AlgoError::BadHorizon(h.to_string()))?;
-                Algo::from_name(name, h)
-            }
-            None => Algo::from_name(s, 1),
-        }
-    }
-}
-
-/// A policy name or horizon that does not parse.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum AlgoError {
-    #[error("unknown algorithm {0:?} (expected one of greedy-nocrit, greedy, uniform, selective)")]
-    Unknown(String),
-    #[error("bad horizon {0:?} (expected a positive integer)")]
-    BadHorizon(String),
-    #[error("the horizon must be at least 1")]
-    ZeroHorizon,
-}
 
 /// The result of one run of a policy.
 #[derive(Debug, Clone, PartialEq)]
@@ -329,7 +244,8 @@ impl<'a> Searcher<'a> {
     /// Runs `algo` with `seed` from the initial mesh. The same seed gives the same run on
     /// every platform (ChaCha8).
     pub fn run(&mut self, algo: Algo, seed: u64) -> RunOutcome {
-        if algo != Algo::GreedyNocrit {
+        let info = algo.info();
+        if info.builds_trees {
             self.state.fresh();
         }
         self.cursor = 0;
@@ -338,39 +254,17 @@ impl<'a> Searcher<'a> {
         self.rng = ChaCha8Rng::seed_from_u64(seed);
         let start = Instant::now();
         self.started = start;
-        let chosen = match algo {
-            Algo::GreedyNocrit => self.greedy_nocrit(),
-            Algo::Greedy => {
-                self.greedy();
-                self.state.chosen().to_vec()
-            }
-            Algo::Uniform { horizon } => {
-                self.uniform(horizon.max(1));
-                self.state.chosen().to_vec()
-            }
-            Algo::Selective { horizon } => {
-                self.selective(horizon.max(1));
-                self.state.chosen().to_vec()
-            }
-        };
+        let chosen = info.policy.run(self, algo.params());
         let time_s = start.elapsed().as_secs_f64();
         let table = self.state.table;
         let quality = table.quality_of(&chosen);
         let quads = chosen.len();
-        let trees = match algo {
-            Algo::Selective { .. } => self.trees,
-            _ => quads as u64,
-        };
         let out = RunOutcome {
             quads,
             triangles_left: self.state.mesh.num_triangles() - 2 * quads,
             quality,
-            nodes_expanded: if matches!(algo, Algo::GreedyNocrit | Algo::Greedy) {
-                quads as u64
-            } else {
-                self.nodes
-            },
-            trees,
+            nodes_expanded: self.nodes,
+            trees: self.trees,
             decisions: quads as u64,
             time_s,
             chosen,

@@ -13,6 +13,7 @@ mod replay;
 mod report;
 mod results;
 mod runner;
+mod runner_budget;
 mod runner_extend;
 mod search;
 mod search_oracle;

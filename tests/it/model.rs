@@ -118,7 +118,7 @@ fn load(name: &str) -> (Mesh, PathBuf) {
 /// `rule` to `dir`/`name` and returns the path and the recombination.
 fn write_recombined(dir: &Path, name: &str, mesh: &Mesh, rule: Rule) -> (PathBuf, Recombined) {
     let table = CandidateTable::build(mesh).restrict(mesh, rule);
-    let run = search::run(mesh, &table, Algo::Selective { horizon: 5 }, 1);
+    let run = search::run(mesh, &table, Algo::selective(5), 1);
     let rec = quality::recombined(mesh, &table, &run.chosen);
     assert!(!rec.quads.is_empty(), "{name}: nothing recombined");
     let out = dir.join(name);

@@ -238,6 +238,7 @@ pub(crate) fn record(
         triangles,
         algo: algo.to_string(),
         horizon,
+        budget: None,
         seed: 1000 + u64::from(run),
         run,
         quads,
@@ -412,6 +413,7 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
             min_eta: 0.0,
             allow_invalid: false,
             plan_version: 2,
+            budgets: Vec::new(),
         },
         backend: "cpu-twin".into(),
         backend_requested: "cpu".into(),
@@ -738,7 +740,7 @@ fn picture_has_sub_pixel_faces_and_an_inset_of_the_densest_region() {
     let out = quadrecomb::internals::search::run(
         &mesh,
         &table,
-        quadrecomb::internals::search::Algo::Greedy,
+        quadrecomb::internals::search::Algo::greedy(),
         SEED,
     );
     let rec = recombined(&mesh, &table, &out.chosen);
@@ -906,6 +908,7 @@ fn real_sphere_dir(dir: &Path, tamper: f64) {
                     triangles: n,
                     algo: algo.into(),
                     horizon: h,
+                    budget: None,
                     seed,
                     run,
                     quads: out.quads,

@@ -280,7 +280,7 @@ fn uniform_tree_equals_exhaustive_search() {
                 .then(a.cmp(&b))
         });
         // Replay the uniform run and check each decision against exhaustive search.
-        let out = search::run(&mesh, &table, Algo::Uniform { horizon: h }, SEED);
+        let out = search::run(&mesh, &table, Algo::uniform(h), SEED);
         let mut state = State::new(&mesh, &table);
         for &c in &out.chosen {
             let mut best = (f64::NEG_INFINITY, NONE);
@@ -301,11 +301,11 @@ fn runs_are_reproducible_and_searchers_reusable() {
     let table = CandidateTable::build(&mesh);
     let mut s = Searcher::new(&mesh, &table);
     for algo in [
-        Algo::GreedyNocrit,
-        Algo::Greedy,
-        Algo::Uniform { horizon: 2 },
-        Algo::Selective { horizon: 1 },
-        Algo::Selective { horizon: 4 },
+        Algo::greedy_nocrit(),
+        Algo::greedy(),
+        Algo::uniform(2),
+        Algo::selective(1),
+        Algo::selective(4),
     ] {
         let w0 = s.criterion_work();
         let a = s.run(algo, SEED);
@@ -321,7 +321,7 @@ fn runs_are_reproducible_and_searchers_reusable() {
         // The work counters are as reproducible as the run (the benchmarks report them).
         let work = |x: (u64, u64), y: (u64, u64)| (y.0 - x.0, y.1 - x.1);
         assert_eq!(work(w0, w1), work(w1, w2), "{algo}");
-        if algo == Algo::GreedyNocrit {
+        if algo == Algo::greedy_nocrit() {
             assert_eq!(work(w0, w1), (0, 0), "no criterion, no search");
         } else {
             assert!(work(w0, w1).0 > 0 && work(w0, w1).1 > 0, "{algo}");
@@ -341,7 +341,7 @@ fn runs_are_reproducible_and_searchers_reusable() {
     }
     // Different seeds explore differently on the selective tree.
     let runs: Vec<_> = (0..6)
-        .map(|k| s.run(Algo::Selective { horizon: 2 }, k).chosen)
+        .map(|k| s.run(Algo::selective(2), k).chosen)
         .collect();
     assert!(runs.iter().any(|r| r != &runs[0]));
 }
@@ -351,11 +351,7 @@ fn policies_respect_the_criterion_and_recombine_a_grid_fully() {
     let mesh = grid(10, 10, 0.2, SEED, |_, _| true, |_, _| 1);
     let table = CandidateTable::build(&mesh);
     let mut s = Searcher::new(&mesh, &table);
-    for algo in [
-        Algo::Greedy,
-        Algo::Selective { horizon: 3 },
-        Algo::Uniform { horizon: 2 },
-    ] {
+    for algo in [Algo::greedy(), Algo::selective(3), Algo::uniform(2)] {
         let out = s.run(algo, SEED);
         // Replaying: every action was allowed when taken.
         let mut state = State::new(&mesh, &table);
@@ -369,25 +365,25 @@ fn policies_respect_the_criterion_and_recombine_a_grid_fully() {
         // Every tree expands its root; only selective skips trees (forced decisions: on
         // this grid, where some triangle always has a single option, all of them).
         assert!(out.nodes_expanded >= out.trees, "{algo}");
-        if matches!(algo, Algo::Selective { .. }) {
+        if algo.name() == "selective" {
             assert!(out.trees <= out.decisions);
         } else {
             assert_eq!(out.trees, out.decisions);
         }
     }
     // Without the criterion, greedy strands triangles on this mesh.
-    let nocrit = s.run(Algo::GreedyNocrit, SEED);
+    let nocrit = s.run(Algo::greedy_nocrit(), SEED);
     assert!(nocrit.quads > 0);
 }
 
 #[test]
 fn algo_names_parse() {
-    assert_eq!("greedy-nocrit".parse::<Algo>().unwrap(), Algo::GreedyNocrit);
     assert_eq!(
-        "selective:5".parse::<Algo>().unwrap(),
-        Algo::Selective { horizon: 5 }
+        "greedy-nocrit".parse::<Algo>().unwrap(),
+        Algo::greedy_nocrit()
     );
-    assert_eq!(Algo::Uniform { horizon: 2 }.to_string(), "uniform");
+    assert_eq!("selective:5".parse::<Algo>().unwrap(), Algo::selective(5));
+    assert_eq!(Algo::uniform(2).to_string(), "uniform");
     assert!("blossom".parse::<Algo>().is_err());
     assert!("uniform:0".parse::<Algo>().is_err());
 }
@@ -449,7 +445,7 @@ fn recombine_cli_prints_json_and_writes_meshes() {
     // Same seed, same run, through the library.
     let mesh = quadrecomb::internals::mesh::load("sphere").unwrap();
     let table = CandidateTable::build(&mesh).restrict(&mesh, Rule::default());
-    let lib = search::run(&mesh, &table, Algo::Selective { horizon: 2 }, 7);
+    let lib = search::run(&mesh, &table, Algo::selective(2), 7);
     assert_eq!(lib.quads as u64, quads);
     assert!((lib.quality - v["quality"].as_f64().unwrap()).abs() < 1e-9);
     // The written mesh holds the quads and the leftover triangles, and `info` on it reads the

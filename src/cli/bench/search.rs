@@ -102,10 +102,7 @@ fn measure(
         rec.push(100.0 * (2 * out.quads) as f64 / triangles as f64);
         bf.push(out.nodes_expanded as f64 / out.decisions.max(1) as f64);
     }
-    let label = match algo {
-        Algo::Uniform { horizon } | Algo::Selective { horizon } => format!("{algo} h={horizon}"),
-        _ => algo.to_string(),
-    };
+    let label = algo.label();
     Row {
         mesh: name.to_string(),
         algo: label,
@@ -127,11 +124,11 @@ fn measure(
 fn greedy_row(name: &str, m: &mesh::Mesh, t: &CandidateTable, runs: u64) {
     let mut s = Searcher::new(m, t);
     let nt = m.num_triangles();
-    let sel = Algo::Selective { horizon: 1 };
+    let sel = Algo::selective(1);
     let (mut g, mut h, mut ratio) = (vec![], vec![], vec![]);
     let mut last = None;
     for _ in 0..RATIO_ROUNDS {
-        let a = measure(&mut s, name, nt, None, Algo::Greedy, runs);
+        let a = measure(&mut s, name, nt, None, Algo::greedy(), runs);
         let b = measure(&mut s, name, nt, None, sel, runs);
         g.push(a.wall_ms);
         h.push(b.wall_ms);
@@ -222,7 +219,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "borouchaki",
         nb,
         Some(bopt),
-        Algo::GreedyNocrit,
+        Algo::greedy_nocrit(),
         args.runs,
     ));
     print_row(&measure(
@@ -230,11 +227,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "borouchaki",
         nb,
         Some(bopt),
-        Algo::Greedy,
+        Algo::greedy(),
         args.runs,
     ));
     for h in 1..=10 {
-        let algo = Algo::Selective { horizon: h };
+        let algo = Algo::selective(h);
         print_row(&measure(
             &mut s,
             "borouchaki",
@@ -252,11 +249,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let ns = sp.num_triangles();
     for h in 1..=args.max_uniform {
         // Deterministic: one run.
-        let algo = Algo::Uniform { horizon: h };
+        let algo = Algo::uniform(h);
         print_row(&measure(&mut s, "sphere", ns, Some(sopt), algo, 1));
     }
     for h in [1, 3] {
-        let algo = Algo::Selective { horizon: h };
+        let algo = Algo::selective(h);
         print_row(&measure(&mut s, "sphere", ns, Some(sopt), algo, args.runs));
     }
     drop(s);
@@ -309,14 +306,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for _ in 0..GRID_ROUNDS {
         for (i, ((g, _), s)) in grids.iter().zip(&mut searchers).enumerate() {
             let nt = g.num_triangles();
-            let r = measure(
-                s,
-                "grid",
-                nt,
-                None,
-                Algo::Selective { horizon: 3 },
-                runs_for(nt),
-            );
+            let r = measure(s, "grid", nt, None, Algo::selective(3), runs_for(nt));
             per[i].push(r.wall_ms * 1e6 / nt as f64);
             recombined[i] = r.recombined_pct;
             work[i] = (r.nodes_per_triangle, r.searched_per_triangle);

@@ -213,7 +213,7 @@ fn selective_tree_equals_naive_replay() {
         for (h, seeds) in [(1, 3u64), (2, 3), (3, 2), (5, 1)] {
             for s in 0..seeds {
                 let seed = SEED ^ (s * 31 + h as u64);
-                let got = searcher.run(Algo::Selective { horizon: h }, seed).chosen;
+                let got = searcher.run(Algo::selective(h), seed).chosen;
                 let expected = naive_selective(mesh, &table, h, seed);
                 assert_eq!(
                     got, expected,
