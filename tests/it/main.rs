@@ -2,6 +2,7 @@
 
 mod cli_edge;
 mod files;
+mod finish;
 mod gpu;
 mod io;
 mod memory;
