@@ -53,7 +53,7 @@ const SPLIT_ATTEMPTS: usize = 8;
 /// Default first ring count of elimination.
 pub const DEFAULT_RINGS: u32 = 2;
 /// Default improvement window, in rings.
-pub const DEFAULT_WINDOW: u32 = 3;
+pub const DEFAULT_WINDOW: u32 = 8;
 
 /// The figures of a pairing after one step.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]

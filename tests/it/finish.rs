@@ -252,3 +252,109 @@ fn all_quad_leaves_no_triangle_in_odd_components() {
         }
     }
 }
+
+// ---------------------------------------------------------------- the command line
+
+/// `recombine --finish --all-quad` on a grid with odd components writes a mesh of quads
+/// only (.msh and .vtu), every quad strictly convex as meshio reads it, and reports the
+/// steps in text and JSON.
+#[test]
+fn cli_recombine_finish_all_quad_writes_only_convex_quads() {
+    let dir = tempfile::tempdir().unwrap();
+    let made = run_in(
+        dir.path(),
+        &[
+            "generate",
+            "grid",
+            "--triangles",
+            "800",
+            "--seed",
+            "1",
+            "--drop-triangles",
+            "1",
+            "-o",
+            "g.msh",
+        ],
+    );
+    assert!(made.status.success());
+    let plain = run_in(
+        dir.path(),
+        &[
+            "recombine",
+            "g.msh",
+            "--algo",
+            "selective",
+            "--horizon",
+            "2",
+            "--finish",
+            "--json",
+        ],
+    );
+    assert!(
+        plain.status.success(),
+        "{}",
+        String::from_utf8_lossy(&plain.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&plain.stdout).unwrap();
+    assert_eq!(
+        v["finish"]["triangles_left"], 1,
+        "one per odd component: {v}"
+    );
+    assert!(v["finish"]["all_quad"].is_null());
+    for out in ["f.msh", "f.vtu"] {
+        let run = run_in(
+            dir.path(),
+            &[
+                "recombine",
+                "g.msh",
+                "--algo",
+                "selective",
+                "--horizon",
+                "2",
+                "--finish",
+                "--all-quad",
+                "-o",
+                out,
+            ],
+        );
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let text = String::from_utf8_lossy(&run.stdout);
+        assert!(text.contains("all-quad"), "{text}");
+        assert!(text.contains("on the chord"), "{text}");
+        assert!(text.contains("improve"), "{text}");
+        if !crate::util::python_module_available("meshio") {
+            continue;
+        }
+        let script = "import meshio, sys\n\
+            m = meshio.read(sys.argv[1])\n\
+            tri = sum(len(c.data) for c in m.cells if c.type == 'triangle')\n\
+            bad = 0\n\
+            quads = [c.data for c in m.cells if c.type == 'quad']\n\
+            n = 0\n\
+            for block in quads:\n\
+            \x20   for q in block:\n\
+            \x20       n += 1\n\
+            \x20       p = m.points[q][:, :2]\n\
+            \x20       s = [(p[(i+1)%4][0]-p[i][0])*(p[(i+2)%4][1]-p[(i+1)%4][1]) - (p[(i+1)%4][1]-p[i][1])*(p[(i+2)%4][0]-p[(i+1)%4][0]) for i in range(4)]\n\
+            \x20       bad += not (all(x > 0 for x in s) or all(x < 0 for x in s))\n\
+            print(tri, n, bad)\n";
+        let line = python(script, &[&dir.path().join(out)]);
+        let f: Vec<usize> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert_eq!(f[0], 0, "{out}: triangles left in the file");
+        assert!(f[1] >= 400, "{out}: {line}");
+        assert_eq!(f[2], 0, "{out}: non-convex quads");
+    }
+    // --all-quad needs --finish.
+    let bad = run_in(
+        dir.path(),
+        &["recombine", "g.msh", "--algo", "greedy", "--all-quad"],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+}
