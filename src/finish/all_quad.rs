@@ -260,7 +260,7 @@ pub(crate) fn split_leftovers(
     let split_set: std::collections::HashSet<u32> = splits.iter().map(|s| s.triangle).collect();
     let mut new_table = CandidateTable::topology_only(&new_mesh);
     let mut keep = vec![false; new_table.len()];
-    for c in 0..new_table.len() {
+    for (c, kept) in keep.iter_mut().enumerate() {
         let [a, b] = new_table.pairs[c];
         let touched = b as usize >= nt || split_set.contains(&a) || split_set.contains(&b);
         if !touched {
@@ -270,7 +270,7 @@ pub(crate) fn split_leftovers(
                 .expect("old triangles keep their neighbours");
             let old = old_of_full[f as usize];
             if old != NONE {
-                keep[c] = true;
+                *kept = true;
                 new_table.eta[c] = table.eta[old as usize];
             }
             continue;
@@ -282,7 +282,7 @@ pub(crate) fn split_leftovers(
             let k = b as usize - nt;
             splits[k].triangle == a
         };
-        keep[c] = rule.allows(eta) && !halves;
+        *kept = rule.allows(eta) && !halves;
     }
     let new_table = new_table.retain(&keep);
     let mut chosen = Vec::new();
