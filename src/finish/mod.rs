@@ -3,10 +3,10 @@
 //! [`crate::search::optimum`] (maximum cardinality, then maximum total eta, pairs the rule
 //! allows only) with everything outside the region fixed. See docs/finish.md.
 //!
-//! Steps, in order: [`leftovers`] (each group of leftovers with k rings of quads around it,
+//! Steps, in order: `leftovers` (each group of leftovers with k rings of quads around it,
 //! k doubling until every leftover that can be paired is, or its component is proven to
 //! leave it), [`all_quad`] (optional: one leftover per odd component moved to the boundary,
-//! a boundary side split, eliminated again), [`improve`] (windows of r rings swept until a
+//! a boundary side split, eliminated again), `improve` (windows of r rings swept until a
 //! pass gains nothing). Imports `mesh`, `quality` and `search::optimum` only.
 
 pub mod all_quad;
