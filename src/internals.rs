@@ -4,6 +4,8 @@
 
 #[path = "experiment/mod.rs"]
 pub mod experiment;
+#[path = "finish/mod.rs"]
+pub mod finish;
 #[path = "gpu/mod.rs"]
 pub mod gpu;
 #[path = "mesh/mod.rs"]

@@ -44,6 +44,9 @@ pub use quality::{CandidateTable, ElementQuality, Rule, RuleError, quad_eta, rec
 pub use search::optimum::{Optimum, solve as optimum};
 pub use search::{Algo, AlgoError, RunOutcome, Searcher, run};
 
+// Finishing what a policy leaves (all quads, near the optimum).
+pub use internals::finish::{FinishConfig, Finished, finish};
+
 // Sweeps and their results.
 pub use experiment::ExperimentError;
 pub use experiment::config::{ConfigError, SweepConfig, SweepRequest};

@@ -1,9 +1,12 @@
 //! `quadrecomb generate`: procedural meshes of any size (jittered grid, icosphere, and
-//! one-cell-wide strip, spiral and maze), written as MSH 4.1 ASCII.
+//! one-cell-wide strip, spiral and maze, jittered equilateral lattice), written as MSH 4.1
+//! ASCII.
 
 use super::UsageError;
 use quadrecomb::internals::mesh::Recombined;
-use quadrecomb::internals::mesh::generate::{self, Corridor, GridSpec, MAX_SUBDIVISIONS};
+use quadrecomb::internals::mesh::generate::{
+    self, Corridor, GridSpec, MAX_GRID_TRIANGLES, MAX_SUBDIVISIONS,
+};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -31,6 +34,23 @@ enum Shape {
     Spiral(CorridorArgs),
     /// A random perfect maze of one-cell corridors (its dual graph is a tree).
     Maze(CorridorArgs),
+    /// A jittered equilateral triangle lattice (rows offset by half a step, interior vertices
+    /// moved by up to 0.15 of an edge): the mesh `bench optimum` and `bench finish` time.
+    Lattice(LatticeArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct LatticeArgs {
+    /// Target number of triangles, at least 2 (the lattice gets 2 * nx * ny, nx the rounded
+    /// square root of the cells, the nearest count at or above it).
+    #[arg(long)]
+    triangles: usize,
+    /// Seed of the jitter (`bench optimum` and `bench finish` use 2).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Output file (.msh, written as MSH 4.1 ASCII).
+    #[arg(short, long)]
+    output: PathBuf,
 }
 
 #[derive(Debug, clap::Args)]
@@ -153,6 +173,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Shape::Strip(a) => corridor(Corridor::Strip, a)?,
         Shape::Spiral(a) => corridor(Corridor::Spiral, a)?,
         Shape::Maze(a) => corridor(Corridor::Maze, a)?,
+        Shape::Lattice(a) => {
+            if !(2..=MAX_GRID_TRIANGLES).contains(&a.triangles) {
+                return Err(UsageError(format!(
+                    "--triangles {}: a lattice has between 2 and {MAX_GRID_TRIANGLES} triangles",
+                    a.triangles
+                ))
+                .into());
+            }
+            check_memory(a.triangles)?;
+            check_output(&a.output)?;
+            let (nx, ny) = generate::lattice_cells(a.triangles);
+            let what = format!("equilateral lattice of {nx} x {ny} cells, seed {}", a.seed);
+            (generate::lattice(a.triangles, a.seed), what, a.output)
+        }
     };
     let generated = start.elapsed().as_secs_f64();
     let start = Instant::now();

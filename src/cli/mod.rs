@@ -3,6 +3,7 @@
 mod bench;
 mod completions;
 mod errors;
+mod finish_report;
 mod generate;
 mod info;
 mod merge;

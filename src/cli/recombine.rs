@@ -63,6 +63,41 @@ pub struct Args {
     backend: EtaBackend,
     #[command(flatten)]
     rule: super::RuleArgs,
+    #[command(flatten)]
+    finish: FinishArgs,
+}
+
+/// Finishing what the policy leaves (docs/finish.md).
+#[derive(Debug, clap::Args)]
+pub struct FinishArgs {
+    /// Finish the run: pair the leftovers that can be paired (each group with rings of quads
+    /// around it re-solved exactly), then improve by exact windows until a pass gains nothing.
+    #[arg(long)]
+    pub finish: bool,
+    /// With --finish: also make odd components even by splitting a boundary side (a new node
+    /// at its midpoint, on the chord), so that no triangle is left where a split allows.
+    #[arg(long, requires = "finish")]
+    pub all_quad: bool,
+    /// With --finish: rings of quads around the leftovers in the first elimination round (k,
+    /// doubled until every leftover is settled).
+    #[arg(long, requires = "finish", default_value_t = quadrecomb::internals::finish::DEFAULT_RINGS, value_parser = clap::value_parser!(u32).range(1..))]
+    pub rings: u32,
+    /// With --finish: rings of quads of each improvement window (r); 0 skips improvement.
+    #[arg(long, requires = "finish", default_value_t = quadrecomb::internals::finish::DEFAULT_WINDOW)]
+    pub window: u32,
+}
+
+impl FinishArgs {
+    /// The finish configuration, if --finish.
+    pub fn config(&self, rule: Rule) -> Option<quadrecomb::internals::finish::FinishConfig> {
+        self.finish
+            .then_some(quadrecomb::internals::finish::FinishConfig {
+                rings: self.rings,
+                window: self.window,
+                all_quad: self.all_quad,
+                rule,
+            })
+    }
 }
 
 /// The candidate table of `mesh` with eta from `backend`, restricted to the pairs `rule`
@@ -122,15 +157,36 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let recombined_pct = 100.0 * (2 * out.quads) as f64 / nt as f64;
     oom::phase(Phase::Optimum);
     let opt = (!args.no_optimum).then(|| optimum::solve(&mesh, &table));
+    let finished = match args.finish.config(rule) {
+        Some(config) => Some(
+            quadrecomb::internals::finish::finish(&mesh, &table, &out.chosen, config)
+                .map_err(|e| anyhow::anyhow!("{}: all-quad split: {e}", args.mesh))?,
+        ),
+        None => None,
+    };
     oom::phase(Phase::Writing);
     let quality_pct = opt
         .as_ref()
         .filter(|o| o.quality > 0.0)
         .map(|o| 100.0 * out.quality / o.quality);
     if let Some(path) = &args.out.output {
-        let rec = quality::recombined(&mesh, &table, &out.chosen);
-        super::write_mesh_output(path, &mesh, &rec, args.out.vtu_ascii)?;
+        match &finished {
+            Some(f) => {
+                let (m, t) = (f.mesh(&mesh), f.table(&table));
+                let rec = quality::recombined(m, t, &f.chosen);
+                super::write_mesh_output(path, m, &rec, args.out.vtu_ascii)?;
+            }
+            None => {
+                let rec = quality::recombined(&mesh, &table, &out.chosen);
+                super::write_mesh_output(path, &mesh, &rec, args.out.vtu_ascii)?;
+            }
+        }
     }
+    let pct_of = |q: f64| {
+        opt.as_ref()
+            .filter(|o| o.quality > 0.0)
+            .map(|o| 100.0 * q / o.quality)
+    };
     let horizon = horizon_of(algo);
     // null where the policy builds no tree (greedy-nocrit), as its sweep record has it.
     let trees = algo.info().builds_trees;
@@ -163,6 +219,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         if let Some(b) = algo.budget() {
             v["budget"] = serde_json::json!(b);
         }
+        if let Some(f) = &finished {
+            v["finish"] = super::finish_report::json(f, &table, pct_of);
+        }
         println!("{v}");
     } else {
         println!("mesh            {}", args.mesh);
@@ -194,6 +253,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             _ => println!("nodes expanded  – (no look-ahead tree: {algo} builds none)"),
         }
         println!("time            {:.4} s", out.time_s);
+        if let Some(f) = &finished {
+            super::finish_report::print(f, &table, pct_of);
+        }
         if let Some(p) = &args.out.output {
             println!("wrote           {}", p.display());
         }

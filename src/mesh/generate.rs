@@ -1,14 +1,17 @@
 //! Procedural meshes of any size, without Gmsh, for tests and scaling benchmarks: jittered
 //! right-triangle grids on the unit square ([`grid`]), icospheres ([`icosphere`]) and
-//! one-cell-wide corridors: strips, spirals and mazes ([`corridor()`]).
+//! one-cell-wide corridors: strips, spirals and mazes ([`corridor()`]), and jittered
+//! equilateral lattices ([`lattice()`]).
 //!
 //! Both are deterministic: a grid depends only on its [`GridSpec`] (the seed drives a ChaCha8
 //! stream, read as raw `u64`s so the result does not change with `rand`'s distributions), on
 //! every platform.
 
 mod corridor;
+mod lattice;
 
 pub use corridor::{Corridor, corridor, validate_corridor};
+pub use lattice::{lattice, lattice_cells};
 
 use super::{Mesh, MeshData};
 use rand::{Rng, SeedableRng};

@@ -3,6 +3,7 @@
 mod across;
 mod cli_edge;
 mod files;
+mod finish;
 mod gpu;
 mod io;
 mod memory;

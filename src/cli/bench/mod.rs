@@ -1,5 +1,6 @@
 //! `quadrecomb bench`: benchmark figures, one subcommand per area.
 
+mod finish;
 mod gpu;
 mod io;
 mod memory;
@@ -24,6 +25,8 @@ enum What {
     Search(search::Args),
     /// Exact optimum.
     Optimum(optimum::Args),
+    /// Selective h=3 + --finish against the exact optimum (lattices; many runs on meshes).
+    Finish(finish::Args),
     /// Quad-quality evaluation: CPU, lavapipe, GPU.
     Gpu(gpu::Args),
     /// Filling a suite's candidate tables: one device batch, one submission per mesh, the
@@ -41,6 +44,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         What::Io(a) => io::run(a),
         What::Search(a) => search::run(a),
         What::Optimum(a) => optimum::run(a),
+        What::Finish(a) => finish::run(a),
         What::Gpu(a) => gpu::run(a),
         What::SuiteEval(a) => suite_eval::run(a),
         What::Memory(a) => memory::run(a),

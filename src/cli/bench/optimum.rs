@@ -2,13 +2,11 @@
 //! generated jittered grids of growing size, with the fitted growth exponent and peak memory.
 
 use crate::cli::UsageError;
+use quadrecomb::internals::mesh::Mesh;
 use quadrecomb::internals::mesh::generate::{self, GridSpec, MAX_GRID_TRIANGLES};
-use quadrecomb::internals::mesh::{Mesh, MeshData};
 use quadrecomb::internals::quality::CandidateTable;
 use quadrecomb::internals::search::optimum;
 use quadrecomb::internals::stats::describe::linear_fit;
-use rand::{RngExt, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use std::process::{Command, ExitCode};
 
 #[derive(Debug, clap::Args)]
@@ -213,44 +211,7 @@ fn grid(n: usize, seed: u64) -> Mesh {
     })
 }
 
-/// A jittered equilateral triangle lattice of about `n` triangles (rows offset by half a
-/// step, interior vertices moved by up to 0.15 of an edge), seeded.
+/// The seeded jittered equilateral lattice of about `n` triangles (`generate lattice`).
 pub fn lattice(n: usize, seed: u64) -> Mesh {
-    let cells = (n / 2).max(1);
-    let nx = ((cells as f64).sqrt().round() as usize).max(1);
-    let ny = cells.div_ceil(nx);
-    let h = 3f64.sqrt() / 2.0;
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut vertices = Vec::with_capacity((nx + 1) * (ny + 1));
-    for j in 0..=ny {
-        for i in 0..=nx {
-            let interior = i > 0 && i < nx && j > 0 && j < ny;
-            let (dx, dy) = if interior {
-                (rng.random_range(-0.15..0.15), rng.random_range(-0.15..0.15))
-            } else {
-                (0.0, 0.0)
-            };
-            let shift = if j % 2 == 1 { 0.5 } else { 0.0 };
-            vertices.push([i as f64 + shift + dx, j as f64 * h + dy, 0.0]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let mut triangles = Vec::with_capacity(2 * nx * ny);
-    for j in 0..ny {
-        for i in 0..nx {
-            if j % 2 == 0 {
-                triangles.push([id(i, j), id(i + 1, j), id(i, j + 1)]);
-                triangles.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-            } else {
-                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            }
-        }
-    }
-    Mesh::new(MeshData {
-        vertices,
-        triangles,
-        ..MeshData::default()
-    })
-    .expect("a jittered lattice is a valid mesh")
+    generate::lattice(n, seed)
 }

@@ -1,0 +1,238 @@
+//! Finishing what a policy leaves: leftover elimination, all-quad splits for odd components,
+//! and local improvement, each by re-solving regions exactly with the blossom matcher of
+//! [`crate::search::optimum`] (maximum cardinality, then maximum total eta, pairs the rule
+//! allows only) with everything outside the region fixed. See docs/finish.md.
+//!
+//! Steps, in order: `leftovers` (each group of leftovers with k rings of quads around it,
+//! k doubling until every leftover that can be paired is, or its component is proven to
+//! leave it), [`all_quad`] (optional: one leftover per odd component moved to the boundary,
+//! a boundary side split, eliminated again), `improve` (windows of r rings swept until a
+//! pass gains nothing). Imports `mesh`, `quality` and `search::optimum` only.
+
+pub mod all_quad;
+mod improve;
+mod leftovers;
+mod region;
+
+pub use all_quad::Split;
+
+use crate::mesh::{Mesh, MeshError};
+use crate::quality::{CandidateTable, Rule};
+use region::{Pairing, RegionSolver, Rings};
+use std::time::Instant;
+
+/// Settings of a finish.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FinishConfig {
+    /// Rings of quads around the leftovers in the first elimination round (k; doubled each
+    /// round until every leftover is settled), at least 1.
+    pub rings: u32,
+    /// Rings of quads of each improvement window around its seed triangle (r); 0 skips
+    /// improvement.
+    pub window: u32,
+    /// Make odd components even by splitting a boundary side (see [`all_quad`]).
+    pub all_quad: bool,
+    /// The rule the pairs obey (needed for the pairs a split makes).
+    pub rule: Rule,
+}
+
+impl Default for FinishConfig {
+    fn default() -> FinishConfig {
+        FinishConfig {
+            rings: DEFAULT_RINGS,
+            window: DEFAULT_WINDOW,
+            all_quad: false,
+            rule: Rule::default(),
+        }
+    }
+}
+
+/// Splits tried per leftover before all-quad gives up on it (each a rebuild of the mesh).
+const SPLIT_ATTEMPTS: usize = 8;
+
+/// Default first ring count of elimination.
+pub const DEFAULT_RINGS: u32 = 2;
+/// Default improvement window, in rings.
+pub const DEFAULT_WINDOW: u32 = 8;
+
+/// The figures of a pairing after one step.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct StepFigures {
+    /// Quads made.
+    pub quads: usize,
+    /// Triangles left.
+    pub triangles_left: usize,
+    /// Sum of eta of the quads.
+    pub quality: f64,
+    /// Seconds the step took.
+    pub time_s: f64,
+}
+
+/// Counters of a finish, for benchmarks and the docs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FinishStats {
+    /// Regions re-solved by elimination (both rounds when all-quad split).
+    pub regions: usize,
+    /// The largest ring count elimination reached.
+    pub max_rings: u32,
+    /// Improvement passes (the last gained nothing).
+    pub passes: usize,
+    /// Improvement windows solved.
+    pub windows: usize,
+    /// Windows whose new pairing was kept.
+    pub kept: usize,
+}
+
+/// A finished pairing.
+#[derive(Debug, Clone)]
+pub struct Finished {
+    /// Chosen candidates, ascending: indices into the input table, or into [`Finished::table`]
+    /// when all-quad split triangles.
+    pub chosen: Vec<u32>,
+    /// The figures after leftover elimination.
+    pub eliminated: StepFigures,
+    /// The figures after all-quad (`None` without `all_quad`); `time_s` includes the second
+    /// elimination.
+    pub all_quad: Option<StepFigures>,
+    /// The figures after local improvement: the result.
+    pub improved: StepFigures,
+    /// The sides split by all-quad (empty without it, or when nothing was odd).
+    pub splits: Vec<Split>,
+    /// The mesh with the split triangles, when all-quad split any.
+    pub mesh: Option<Mesh>,
+    /// Its candidate table under the same rule.
+    pub table: Option<CandidateTable>,
+    /// Counters.
+    pub stats: FinishStats,
+}
+
+impl Finished {
+    /// The whole time of the finish.
+    pub fn time_s(&self) -> f64 {
+        self.eliminated.time_s + self.all_quad.map_or(0.0, |s| s.time_s) + self.improved.time_s
+    }
+
+    /// The mesh the result pairs (`input` unless all-quad split triangles).
+    pub fn mesh<'a>(&'a self, input: &'a Mesh) -> &'a Mesh {
+        self.mesh.as_ref().unwrap_or(input)
+    }
+
+    /// The candidate table `chosen` indexes.
+    pub fn table<'a>(&'a self, input: &'a CandidateTable) -> &'a CandidateTable {
+        self.table.as_ref().unwrap_or(input)
+    }
+}
+
+fn figures(table: &CandidateTable, pairing: &Pairing, time_s: f64) -> StepFigures {
+    let chosen = pairing.chosen(table);
+    StepFigures {
+        quads: chosen.len(),
+        triangles_left: pairing.cand.len() - 2 * chosen.len(),
+        quality: table.quality_of(&chosen),
+        time_s,
+    }
+}
+
+/// Finishes the pairing `chosen` (candidates of `table`, a matching) of `mesh`. Errors only
+/// when all-quad's split makes an invalid mesh (it should not: a boundary side halved).
+pub fn finish(
+    mesh: &Mesh,
+    table: &CandidateTable,
+    chosen: &[u32],
+    config: FinishConfig,
+) -> Result<Finished, MeshError> {
+    let nt = mesh.num_triangles();
+    let mut stats = FinishStats::default();
+    let t0 = Instant::now();
+    let mut pairing = Pairing::new(nt, table, chosen);
+    let mut rings = Rings::new(nt);
+    let mut solver = RegionSolver::new(nt);
+    let e = leftovers::eliminate(table, &mut pairing, &mut rings, &mut solver, config.rings);
+    stats.regions += e.regions;
+    stats.max_rings = e.max_rings;
+    let eliminated = figures(table, &pairing, t0.elapsed().as_secs_f64());
+
+    let mut split_mesh = None;
+    let mut all_quad = None;
+    let mut splits = Vec::new();
+    if config.all_quad {
+        let t1 = Instant::now();
+        let mut pairing_after = None;
+        let left: Vec<u32> = pairing.leftovers().collect();
+        let mut excluded = vec![false; nt];
+        for _ in 0..SPLIT_ATTEMPTS {
+            if left.is_empty() {
+                break;
+            }
+            let mut p = pairing.clone();
+            let Some(s) =
+                all_quad::split_leftovers(mesh, table, &mut p, &left, config.rule, &excluded)?
+            else {
+                break;
+            };
+            let n = s.mesh.num_triangles();
+            let mut p = s.pairing;
+            let (mut r, mut so) = (Rings::new(n), RegionSolver::new(n));
+            let e = leftovers::eliminate(&s.table, &mut p, &mut r, &mut so, config.rings);
+            stats.regions += e.regions;
+            stats.max_rings = stats.max_rings.max(e.max_rings);
+            // A split whose component still leaves a triangle did not make it perfectly
+            // matchable: try that leftover elsewhere.
+            let (component, _) = CandidateTable::components(&s.table.dual_graph());
+            let mut stuck = vec![false; n];
+            for t in p.leftovers() {
+                stuck[component[t as usize] as usize] = true;
+            }
+            let failed: Vec<u32> = s
+                .splits
+                .iter()
+                .map(|sp| sp.triangle)
+                .filter(|&b| stuck[component[b as usize] as usize])
+                .collect();
+            let done = failed.is_empty();
+            for b in failed {
+                excluded[b as usize] = true;
+            }
+            let better = split_mesh.is_none() || done;
+            if better {
+                pairing_after = Some(p);
+                rings = r;
+                solver = so;
+                splits = s.splits;
+                split_mesh = Some((s.mesh, s.table));
+            }
+            if done {
+                break;
+            }
+        }
+        if let Some(p) = pairing_after {
+            pairing = p;
+        }
+        let t = split_mesh.as_ref().map_or(table, |(_, t)| t);
+        all_quad = Some(figures(t, &pairing, t1.elapsed().as_secs_f64()));
+    }
+    let t = split_mesh.as_ref().map_or(table, |(_, t)| t);
+    let t2 = Instant::now();
+    if config.window > 0 {
+        let i = improve::improve(t, &mut pairing, &mut rings, &mut solver, config.window);
+        stats.passes = i.passes;
+        stats.windows = i.windows;
+        stats.kept = i.kept;
+    }
+    let improved = figures(t, &pairing, t2.elapsed().as_secs_f64());
+    let chosen = pairing.chosen(t);
+    let (mesh, table) = match split_mesh {
+        Some((m, t)) => (Some(m), Some(t)),
+        None => (None, None),
+    };
+    Ok(Finished {
+        chosen,
+        eliminated,
+        all_quad,
+        improved,
+        splits,
+        mesh,
+        table,
+        stats,
+    })
+}
