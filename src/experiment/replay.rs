@@ -327,7 +327,7 @@ fn eta_phrase(source: EtaSource, name: &str, first: bool, recorded: &str) -> Str
 
 /// Loads the mesh of `record` from where it may be: the manifest's source as given (from this
 /// working directory), the absolute path the sweep recorded, the source relative to the
-/// results directory, the built-in of that name; the first with the recorded hash. Returns it
+/// results directory, its file name inside the results directory, the built-in of that name; the first with the recorded hash. Returns it
 /// and the file it was read from (`None` for a built-in).
 fn load_mesh(
     dir: &Path,
@@ -341,6 +341,13 @@ fn load_mesh(
     let beside = dir.join(&source);
     if beside.is_file() {
         places.push(beside.to_string_lossy().into_owned());
+    }
+    // A mesh kept in the results directory itself (as the committed results keep theirs).
+    if let Some(inside) = Path::new(&source).file_name().map(|f| dir.join(f))
+        && inside != beside
+        && inside.is_file()
+    {
+        places.push(inside.to_string_lossy().into_owned());
     }
     let loads = places.iter().map(|p| -> Result<_, crate::mesh::ReadError> {
         let src = crate::mesh::source(p)?;

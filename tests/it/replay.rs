@@ -260,3 +260,32 @@ fn replay_refuses_what_it_cannot_reproduce() {
     refused(&o, 3, "mesh m.msh has changed since the sweep");
     assert!(!t.join("out.msh").exists());
 }
+
+/// A results directory that keeps its mesh file inside it (as the committed results do) and
+/// was moved, with the sweep's absolute path gone from its manifest: the mesh is found by its
+/// file name inside the directory, from any working directory.
+#[test]
+fn replay_finds_a_mesh_kept_inside_a_moved_results_directory() {
+    let tmp = tempfile::tempdir().unwrap();
+    let work = tmp.path().join("work");
+    std::fs::create_dir_all(work.join("data")).unwrap();
+    generate_grid(&work.join("data"), "5");
+    let dir = sweep(&work, "data/m.msh", "res", &["--backend", "cpu"]);
+    std::fs::rename(work.join("data/m.msh"), dir.join("m.msh")).unwrap();
+    let manifest = dir.join("manifest.json");
+    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(&manifest).unwrap()).unwrap();
+    v["spec"]["meshes"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("path");
+    std::fs::write(&manifest, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let moved = tmp.path().join("elsewhere");
+    std::fs::rename(&dir, &moved).unwrap();
+    let r = records(&moved)
+        .into_iter()
+        .find(|r| r.algo == "selective")
+        .unwrap();
+    let v = json(&replay(tmp.path(), &moved, &r.run.to_string(), &r, &[]));
+    assert_eq!(v["reproduced"], true, "{v}");
+    assert_eq!(v["quads"], r.quads, "{v}");
+}

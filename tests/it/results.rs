@@ -144,6 +144,9 @@ fn committed_reports_regenerate_unchanged() {
         "sphere-uniform",
         "borouchaki",
         "borouchaki-allow-invalid",
+        "suite",
+        "budget",
+        "budget-transfer",
     ] {
         let src = repo_path(&format!("results/{case}"));
         if !src.join("report.md").exists() {
