@@ -147,6 +147,7 @@ fn committed_reports_regenerate_unchanged() {
         "suite",
         "budget",
         "budget-transfer",
+        "budget-beam",
     ] {
         let src = repo_path(&format!("results/{case}"));
         if !src.join("report.md").exists() {
