@@ -70,6 +70,10 @@ pub struct SweepSpec {
     /// when no such method is swept.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub budgets: Vec<u32>,
+    /// Each search run is finished after its search with these settings (`sweep
+    /// --finish`); absent without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub finish: Option<super::finished::FinishSettings>,
 }
 
 /// The plan version of manifests written before the field existed.
@@ -449,6 +453,12 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     }
     if a.rule() != b.rule() {
         return Some(format!("rule {} vs {}", a.rule(), b.rule()));
+    }
+    if a.finish != b.finish {
+        let say = |f: Option<super::finished::FinishSettings>| {
+            f.map_or("no finish".to_string(), |s| s.to_string())
+        };
+        return Some(format!("{} vs {}", say(a.finish), say(b.finish)));
     }
     if a.plan_version != b.plan_version {
         return Some(format!(
