@@ -338,8 +338,8 @@ impl Manifest {
 }
 
 /// The first difference between two specs in what decides the seeds and results of the runs
-/// they share: the meshes (by name, hash and size), the base seed, the rule and the plan
-/// version. Specs without one may hold different algorithms, horizons and run counts: every
+/// they share: the meshes (by name, hash and size), the base seed, the rule, the plan
+/// version and the finish settings. Specs without one may hold different algorithms, horizons and run counts: every
 /// run they have in common is the same run.
 pub fn base_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     let mut b2 = a.clone();
@@ -348,6 +348,7 @@ pub fn base_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     b2.min_eta = b.min_eta;
     b2.allow_invalid = b.allow_invalid;
     b2.plan_version = b.plan_version;
+    b2.finish = b.finish;
     spec_difference(a, &b2)
 }
 
