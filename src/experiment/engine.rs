@@ -104,9 +104,11 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
         allow_invalid: manifest.spec.allow_invalid,
         backend: manifest.backend.clone(),
         version: manifest.version.clone(),
-        finish: out.finish.as_ref().zip(manifest.spec.finish).map(|(f, s)| {
-            super::finished::FinishRecord::new(s, f, mesh.triangles, optimum)
-        }),
+        finish: out
+            .finish
+            .as_ref()
+            .zip(manifest.spec.finish)
+            .map(|(f, s)| super::finished::FinishRecord::new(s, f, mesh.triangles, optimum)),
     }
 }
 

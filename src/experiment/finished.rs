@@ -128,7 +128,9 @@ impl FinishRecord {
                 100.0 * 2.0 * out.quads as f64 / triangles as f64
             },
             quality: out.quality,
-            quality_pct: optimum.filter(|&o| o > 0.0).map(|o| 100.0 * out.quality / o),
+            quality_pct: optimum
+                .filter(|&o| o > 0.0)
+                .map(|o| 100.0 * out.quality / o),
             worst_eta: out.elements.worst,
             mean_eta: out.elements.mean,
             eliminate_s: out.eliminate_s,
