@@ -398,7 +398,6 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
     let hash = "0123456789abcdef0123456789abcdef".to_string();
     Manifest {
         version: "0.1.0".into(),
-        finish: None,
         spec: SweepSpec {
             meshes: vec![MeshEntry {
                 name: "sphere".into(),
