@@ -174,6 +174,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "output": write,
         });
         super::add_element_fields(&mut v, &out.elements, rule);
+        if let (Some(f), Some(rf)) = (&out.finish, &record.finish) {
+            v["finish"] = serde_json::json!(f);
+            v["recorded"]["finish"] = serde_json::json!(rf);
+        }
         if let Some(b) = record.budget {
             v["budget"] = serde_json::json!(b);
         }
@@ -205,6 +209,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "time            {:.4} s (recorded {:.4} s)",
             out.time_s, record.time_s
         );
+        if let (Some(f), Some(rf)) = (&out.finish, &record.finish) {
+            println!(
+                "finished        {} quads, {} triangles left, quality {:.6} (recorded {} quads, \
+                 {} left, {:.6}; rings {}, window {}; finish {:.4} s, recorded {:.4} s)",
+                f.quads,
+                f.triangles_left,
+                f.quality,
+                rf.quads,
+                rf.triangles_left,
+                rf.quality,
+                f.rings,
+                f.window,
+                f.time_s,
+                rf.time_s
+            );
+        }
         let same = if out.reproduced { "yes" } else { "no" };
         println!("reproduced      {same}");
         if let Some(p) = write {

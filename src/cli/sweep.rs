@@ -113,6 +113,25 @@ pub struct Args {
     /// progress and notes stay on stderr.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    finish: SweepFinishArgs,
+}
+
+/// Finishing each search run after its search (docs/finish.md).
+#[derive(Debug, clap::Args)]
+pub struct SweepFinishArgs {
+    /// Finish each search run after its search: pair the leftovers that can be paired, then
+    /// improve by local re-solves. Records keep the search's figures and add a `finish`
+    /// object; the report adds "+ finish" rows. Not for the optimum (nothing to finish).
+    #[arg(long)]
+    finish: bool,
+    /// With --finish: rings of quads around the leftovers in the first elimination round (k,
+    /// doubled until every leftover is settled).
+    #[arg(long, requires = "finish", default_value_t = quadrecomb::internals::finish::DEFAULT_RINGS, value_parser = clap::value_parser!(u32).range(1..))]
+    rings: u32,
+    /// With --finish: rings of quads of each improvement window (r); 0 skips improvement.
+    #[arg(long, requires = "finish", default_value_t = quadrecomb::internals::finish::DEFAULT_WINDOW)]
+    window: u32,
 }
 
 /// The sweep's own files that exist in `dir` (runs, manifest, summaries), by role, for a
@@ -229,6 +248,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         extend: args.extend,
         overwrite: args.overwrite,
         shard: args.shard,
+        finish: args.finish.finish.then_some(
+            quadrecomb::internals::experiment::finished::FinishSettings {
+                rings: args.finish.rings,
+                window: args.finish.window,
+            },
+        ),
     })
     .map_err(config_error)?;
     let fixed: Vec<&str> = (config.algos().iter())

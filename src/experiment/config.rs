@@ -66,6 +66,8 @@ pub struct SweepRequest {
     pub overwrite: bool,
     /// Run only this slice of the run list.
     pub shard: Option<Shard>,
+    /// Finish each search run after its search with these settings (`--finish`).
+    pub finish: Option<super::finished::FinishSettings>,
 }
 
 impl Default for SweepRequest {
@@ -86,6 +88,7 @@ impl Default for SweepRequest {
             extend: false,
             overwrite: false,
             shard: None,
+            finish: None,
         }
     }
 }
@@ -366,6 +369,7 @@ impl SweepConfig {
             min_eta: c.rule.min_eta(),
             allow_invalid: c.rule.allows_invalid(),
             plan_version: super::seed::PLAN_VERSION,
+            finish: c.finish,
         }
     }
 

@@ -104,6 +104,11 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
         allow_invalid: manifest.spec.allow_invalid,
         backend: manifest.backend.clone(),
         version: manifest.version.clone(),
+        finish: out
+            .finish
+            .as_ref()
+            .zip(manifest.spec.finish)
+            .map(|(f, s)| super::finished::FinishRecord::new(s, f, mesh.triangles, optimum)),
     }
 }
 
@@ -159,6 +164,28 @@ pub fn check_records(
                     runs.display(),
                     r.rule(),
                     manifest.spec.rule()
+                ),
+            });
+        }
+        let finished = r.finish.as_ref().map(|f| (f.rings, f.window));
+        let wanted = manifest
+            .spec
+            .finish
+            .filter(|_| super::record::is_search(&r.algo))
+            .map(|s| (s.rings, s.window));
+        if finished != wanted {
+            let say = |f: Option<(u32, u32)>| {
+                f.map_or("no finish".to_string(), |(k, w)| {
+                    format!("finish rings {k} window {w}")
+                })
+            };
+            return Err(ExperimentError::ForeignRecords {
+                dir: path.to_path_buf(),
+                message: format!(
+                    "{}:{line}: run {key} has {}, this sweep's runs have {}",
+                    runs.display(),
+                    say(finished),
+                    say(wanted)
                 ),
             });
         }
@@ -258,6 +285,17 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             return Err(format!(
                 "quality_pct {pct} is not a finite non-negative number"
             ));
+        }
+    }
+    if let Some(f) = &r.finish {
+        f.check(r.triangles)?;
+        if let Some(opt) = optimum {
+            if f.quads > opt.quads {
+                return Err(format!(
+                    "finish: {} quads, more than the {} of its mesh's optimum",
+                    f.quads, opt.quads
+                ));
+            }
         }
     }
     let Some(opt) = optimum else {
@@ -712,6 +750,7 @@ pub(crate) mod tests {
             decisions: 10,
             time_s: 0.5,
             elements: crate::quality::ElementQuality::of([0.5, 0.9]),
+            finish: None,
         };
         let r = make_record(&m, &job, out);
         assert_eq!(r.quality_pct, Some(75.0));

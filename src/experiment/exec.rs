@@ -30,6 +30,8 @@ pub struct Outcome {
     pub time_s: f64,
     /// Worst and mean eta of the quads, and the poor ones.
     pub elements: ElementQuality,
+    /// The run after its finish (`sweep --finish`).
+    pub finish: Option<super::finished::FinishOutcome>,
 }
 
 impl Outcome {
@@ -45,6 +47,7 @@ impl Outcome {
             decisions: out.decisions,
             time_s: out.time_s,
             elements: ElementQuality::of_chosen(table, &out.chosen),
+            finish: None,
         }
     }
 
@@ -60,6 +63,7 @@ impl Outcome {
             decisions: o.quads as u64,
             time_s: o.time_s,
             elements: o.elements,
+            finish: None,
         }
     }
 }
@@ -187,6 +191,7 @@ pub(crate) mod tests {
             decisions: 5,
             time_s: 0.001 * f64::from(h),
             elements: crate::quality::ElementQuality::of([0.5, 0.9]),
+            finish: None,
         }
     }
 

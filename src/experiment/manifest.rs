@@ -70,6 +70,10 @@ pub struct SweepSpec {
     /// when no such method is swept.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub budgets: Vec<u32>,
+    /// Each search run is finished after its search with these settings (`sweep
+    /// --finish`); absent without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub finish: Option<super::finished::FinishSettings>,
 }
 
 /// The plan version of manifests written before the field existed.
@@ -334,8 +338,8 @@ impl Manifest {
 }
 
 /// The first difference between two specs in what decides the seeds and results of the runs
-/// they share: the meshes (by name, hash and size), the base seed, the rule and the plan
-/// version. Specs without one may hold different algorithms, horizons and run counts: every
+/// they share: the meshes (by name, hash and size), the base seed, the rule, the plan
+/// version and the finish settings. Specs without one may hold different algorithms, horizons and run counts: every
 /// run they have in common is the same run.
 pub fn base_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     let mut b2 = a.clone();
@@ -344,6 +348,7 @@ pub fn base_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     b2.min_eta = b.min_eta;
     b2.allow_invalid = b.allow_invalid;
     b2.plan_version = b.plan_version;
+    b2.finish = b.finish;
     spec_difference(a, &b2)
 }
 
@@ -449,6 +454,12 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     }
     if a.rule() != b.rule() {
         return Some(format!("rule {} vs {}", a.rule(), b.rule()));
+    }
+    if a.finish != b.finish {
+        let say = |f: Option<super::finished::FinishSettings>| {
+            f.map_or("no finish".to_string(), |s| s.to_string())
+        };
+        return Some(format!("{} vs {}", say(a.finish), say(b.finish)));
     }
     if a.plan_version != b.plan_version {
         return Some(format!(

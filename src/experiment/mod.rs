@@ -10,6 +10,7 @@ pub mod config;
 pub mod engine;
 pub mod events;
 pub mod exec;
+pub mod finished;
 pub mod lock;
 pub mod manifest;
 pub mod merge;

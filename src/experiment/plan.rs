@@ -196,6 +196,7 @@ pub(crate) mod tests {
 
     pub(crate) fn spec() -> SweepSpec {
         SweepSpec {
+            finish: None,
             meshes: vec![
                 MeshEntry {
                     name: "a".into(),

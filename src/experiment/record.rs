@@ -89,6 +89,10 @@ pub struct RunRecord {
     pub backend: String,
     /// Version of quadrecomb that made the record.
     pub version: String,
+    /// The run after `sweep --finish` (leftover elimination and local improvement, see
+    /// docs/finish.md); absent without it. The fields above stay the search's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub finish: Option<super::finished::FinishRecord>,
 }
 
 /// Whether `algo` (a record's name) searches with look-ahead trees, so that its
@@ -165,12 +169,15 @@ impl RunRecord {
         }
     }
 
-    /// Whether two records hold the same result: every field but `time_s` (wall-clock time
-    /// differs between any two executions) is equal.
+    /// Whether two records hold the same result: every field but `time_s` and the finish's
+    /// times (wall-clock time differs between any two executions) is equal.
     pub fn same_result(&self, other: &RunRecord) -> bool {
         let mut a = self.clone();
         a.time_s = other.time_s;
-        a == *other
+        let mut b = other.clone();
+        a.finish = a.finish.as_ref().map(|f| f.without_times());
+        b.finish = b.finish.as_ref().map(|f| f.without_times());
+        a == b
     }
 
     /// The record as one JSON line, without the newline.

@@ -168,8 +168,11 @@ pub struct Replayed<'a> {
     /// Whether that table is the sweep's.
     pub eta_check: EtaCheck,
     /// Whether the replay gave the record's quads and quality (to 1e-9 relative: JSON may
-    /// round the recorded float by an ulp).
+    /// round the recorded float by an ulp), and, for a finished run, its finish's too.
     pub reproduced: bool,
+    /// The replayed run finished again with the record's settings, when the record has a
+    /// `finish` object (`sweep --finish`): its figures in the record's form.
+    pub finish: Option<super::finished::FinishRecord>,
 }
 
 impl Replayed<'_> {
@@ -228,8 +231,28 @@ impl<'m> Replayer<'m> {
                 (o.chosen, o.quads, o.triangles_left, o.quality, o.time_s)
             }
         };
-        let reproduced = quads == record.quads
-            && (quality - record.quality).abs() <= 1e-9 * record.quality.abs().max(1.0);
+        let same = |q: usize, x: f64, rq: usize, rx: f64| {
+            q == rq && (x - rx).abs() <= 1e-9 * rx.abs().max(1.0)
+        };
+        let finish = record.finish.as_ref().map(|f| {
+            let settings = super::finished::FinishSettings {
+                rings: f.rings,
+                window: f.window,
+            };
+            let out =
+                super::finished::finish_run(&p.mesh, &p.table, &chosen, settings, record.rule());
+            // The optimum the record's percentage was taken against.
+            let optimum = record
+                .quality_pct
+                .filter(|&pct| pct > 0.0)
+                .map(|pct| 100.0 * record.quality / pct);
+            super::finished::FinishRecord::new(settings, &out, record.triangles, optimum)
+        });
+        let reproduced = same(quads, quality, record.quads, record.quality)
+            && match (&finish, &record.finish) {
+                (Some(a), Some(b)) => same(a.quads, a.quality, b.quads, b.quality),
+                _ => true,
+            };
         Ok(Replayed {
             mesh: &p.mesh,
             mesh_file: p.file.as_deref(),
@@ -242,6 +265,7 @@ impl<'m> Replayer<'m> {
             eta: &p.eta,
             eta_check: p.check,
             reproduced,
+            finish,
         })
     }
 

@@ -158,6 +158,7 @@ pub(crate) mod tests {
             allow_invalid: false,
             backend: "cpu-twin".into(),
             version: "0.1.0".into(),
+            finish: None,
         }
     }
 

@@ -3,7 +3,9 @@
 //!
 //! summary.csv is long-format: one row per (mesh, algo, horizon, metric) with the columns
 //! `mesh,algo,horizon,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers`
-//! (horizon empty for algorithms without one). Metrics: `quality_pct`, `recombined_pct`,
+//! (horizon empty for algorithms without one; a `budget` column after it when a group has a
+//! budget, and a `finish` column, "finish" on the rows of the finished groups of `sweep
+//! --finish`, when a group is finished). Metrics: `quality_pct`, `recombined_pct`,
 //! `time_s`, `nodes_expanded`, `branching_factor`, `mean_eta`, `worst_eta`,
 //! `quads_eta_below_0_1`, `quads_eta_below_0_3` (each only where its runs record it).
 //! summary.json holds the same groups with the outlier values, and the growth fits.
@@ -47,6 +49,11 @@ pub struct Group {
     /// Node budget per decision, for the budgeted policies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub budget: Option<u32>,
+    /// The group's figures are its runs after their finish (`sweep --finish`: the records'
+    /// `finish` objects), beside the raw group of the same configuration; absent (false)
+    /// for the raw groups. Time is then the finish's alone; no tree figures.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub finished: bool,
     /// Runs in the group.
     pub n: usize,
     /// Quality as % of the optimum (`None` when no run knows the optimum).
@@ -122,6 +129,7 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
                 algo,
                 horizon,
                 budget,
+                finished: false,
                 n: rs.len(),
                 quality_pct: BoxStats::of(&col(&|r| r.quality_pct)),
                 recombined_pct: BoxStats::of(&col(&|r| Some(r.recombined_pct))),
@@ -140,9 +148,15 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
             }
         })
         .collect();
+    let mut groups = groups;
+    groups.extend(finished_groups(records));
+    groups.sort_by(|a, b| {
+        (&a.mesh, &a.algo, a.horizon, a.budget, a.finished)
+            .cmp(&(&b.mesh, &b.algo, b.horizon, b.budget, b.finished))
+    });
     let mut curves: BTreeMap<(String, String), Vec<(u32, f64)>> = BTreeMap::new();
     for g in &groups {
-        if let (Some(h), Some(t), None) = (g.horizon, &g.time_s, g.budget) {
+        if let (Some(h), Some(t), None, false) = (g.horizon, &g.time_s, g.budget, g.finished) {
             curves
                 .entry((g.mesh.clone(), g.algo.clone()))
                 .or_default()
@@ -170,6 +184,48 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
     Summary { groups, growth }
 }
 
+/// The groups of the finished runs (records with a `finish` object), one per configuration:
+/// quality %, recombined %, the finish's time, mean and worst eta after the finish.
+fn finished_groups(records: &[RunRecord]) -> Vec<Group> {
+    type Key = (String, String, Option<u32>, Option<u32>);
+    let mut by: BTreeMap<Key, Vec<&super::finished::FinishRecord>> = BTreeMap::new();
+    for r in records {
+        if let Some(f) = &r.finish {
+            by.entry((r.mesh.clone(), r.algo.clone(), r.horizon, r.budget))
+                .or_default()
+                .push(f);
+        }
+    }
+    by.into_iter()
+        .map(|((mesh, algo, horizon, budget), fs)| {
+            let col = |f: &dyn Fn(&super::finished::FinishRecord) -> Option<f64>| -> Vec<f64> {
+                fs.iter()
+                    .filter_map(|r| f(r))
+                    .filter(|x| x.is_finite())
+                    .collect()
+            };
+            Group {
+                mesh,
+                algo,
+                horizon,
+                budget,
+                finished: true,
+                n: fs.len(),
+                quality_pct: BoxStats::of(&col(&|f| f.quality_pct)),
+                recombined_pct: BoxStats::of(&col(&|f| Some(f.recombined_pct))),
+                time_s: BoxStats::of(&col(&|f| Some(f.time_s))),
+                nodes_expanded: None,
+                branching_factor: None,
+                mean_branching_factor: None,
+                mean_eta: BoxStats::of(&col(&|f| f.mean_eta)),
+                worst_eta: BoxStats::of(&col(&|f| f.worst_eta)),
+                quads_eta_below_0_1: None,
+                quads_eta_below_0_3: None,
+            }
+        })
+        .collect()
+}
+
 impl Group {
     fn metric(&self, name: &str) -> Option<&BoxStats> {
         match name {
@@ -192,11 +248,17 @@ pub fn to_csv(summary: &Summary) -> String {
     // The budget column only where a group has a budget: summaries without one read as
     // they always did.
     let budgets = summary.groups.iter().any(|g| g.budget.is_some());
+    // Likewise the finish column ("finish" on the finished groups' rows), only where a group
+    // is finished.
+    let finish = summary.groups.iter().any(|g| g.finished);
     let mut out = String::from(if budgets {
         "mesh,algo,horizon,budget,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers\n"
     } else {
         "mesh,algo,horizon,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers\n"
     });
+    if finish {
+        out = out.replacen(",metric,", ",finish,metric,", 1);
+    }
     for g in &summary.groups {
         for &metric in METRICS {
             if let Some(b) = g.metric(metric) {
@@ -204,6 +266,9 @@ pub fn to_csv(summary: &Summary) -> String {
                 if budgets {
                     h.push(',');
                     h.push_str(&g.budget.map(|b| b.to_string()).unwrap_or_default());
+                }
+                if finish {
+                    h.push_str(if g.finished { ",finish" } else { "," });
                 }
                 out.push_str(&format!(
                     "{},{},{h},{metric},{},{},{},{},{},{},{},{},{},{},{}\n",

@@ -254,6 +254,8 @@ pub struct SearchFactory<'a> {
     meshes: &'a [Mesh],
     tables: &'a [CandidateTable],
     optimum: &'a [OptimumEntry],
+    finish: Option<super::finished::FinishSettings>,
+    rule: crate::quality::Rule,
 }
 
 impl<'a> SearchFactory<'a> {
@@ -263,6 +265,8 @@ impl<'a> SearchFactory<'a> {
             meshes: &prepared.meshes,
             tables: &prepared.tables,
             optimum: &prepared.manifest.optimum,
+            finish: prepared.manifest.spec.finish,
+            rule: prepared.manifest.spec.rule(),
         }
     }
 }
@@ -296,7 +300,18 @@ impl Worker for SearchWorker<'_> {
         let searcher = self.searchers[job.mesh]
             .get_or_insert_with(|| Searcher::new(&f.meshes[job.mesh], &f.tables[job.mesh]));
         let out = searcher.run(algo, job.seed);
-        Ok(Outcome::of_run(&out, &f.tables[job.mesh]))
+        let mut outcome = Outcome::of_run(&out, &f.tables[job.mesh]);
+        if let Some(settings) = f.finish {
+            let (mesh, table) = (&f.meshes[job.mesh], &f.tables[job.mesh]);
+            outcome.finish = Some(super::finished::finish_run(
+                mesh,
+                table,
+                &out.chosen,
+                settings,
+                f.rule,
+            ));
+        }
+        Ok(outcome)
     }
 }
 

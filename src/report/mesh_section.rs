@@ -92,6 +92,8 @@ pub(super) fn mesh_section(
             fmt_opt(median_of(summary, c, |g| g.branching_factor.as_ref()), 3),
         ]
     });
+    let mut rows = rows;
+    rows.extend(super::finished::table_rows(summary, &configs));
     doc.table(
         [
             "algorithm",
@@ -119,6 +121,7 @@ pub(super) fn mesh_section(
          decisions are unchanged), and its time grows more slowly with the horizon.",
     );
 
+    super::finished::what_it_added(doc, summary, &configs);
     element_table(doc, summary, &configs);
     greedy_paradox(doc, &configs);
     super::beside_paper::paper_beside(doc, summary, mesh, &configs);

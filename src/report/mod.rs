@@ -15,6 +15,7 @@ mod budget;
 mod cd_diagram;
 mod compare;
 mod document;
+mod finished;
 mod format;
 mod mesh_section;
 mod methods;

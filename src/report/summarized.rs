@@ -6,10 +6,23 @@ use super::{Config, Metric, Run};
 use crate::experiment::summary::{Group, GrowthEntry, Summary};
 use crate::stats::describe::BoxStats;
 
-/// The summary's group of configuration `c`.
+/// The summary's group of configuration `c`: its raw runs.
 fn group<'s>(summary: &'s Summary, c: &Config) -> Option<&'s Group> {
+    finished_or_raw(summary, c, false)
+}
+
+/// The summary's group of the runs of `c` after their finish (`sweep --finish`), if any.
+pub(super) fn finished_group<'s>(summary: &'s Summary, c: &Config) -> Option<&'s Group> {
+    finished_or_raw(summary, c, true)
+}
+
+fn finished_or_raw<'s>(summary: &'s Summary, c: &Config, finished: bool) -> Option<&'s Group> {
     (summary.groups.iter()).find(|g| {
-        g.mesh == c.mesh && g.algo == c.algo && g.horizon == c.horizon && g.budget == c.budget
+        g.mesh == c.mesh
+            && g.algo == c.algo
+            && g.horizon == c.horizon
+            && g.budget == c.budget
+            && g.finished == finished
     })
 }
 

@@ -19,5 +19,6 @@ mod runner_extend;
 mod search;
 mod search_oracle;
 mod suite;
+mod sweep_finish;
 mod util;
 mod valid_output;

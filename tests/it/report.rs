@@ -259,6 +259,7 @@ pub(crate) fn record(
         allow_invalid: false,
         backend: "cpu-twin".to_string(),
         version: "0.1.0".to_string(),
+        finish: None,
     }
     .to_json_line()
 }
@@ -414,6 +415,7 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
             allow_invalid: false,
             plan_version: 2,
             budgets: Vec::new(),
+            finish: None,
         },
         backend: "cpu-twin".into(),
         backend_requested: "cpu".into(),
@@ -929,6 +931,7 @@ fn real_sphere_dir(dir: &Path, tamper: f64) {
                     allow_invalid: false,
                     backend: "cpu-twin".into(),
                     version: "0.1.0".into(),
+                    finish: None,
                 }
                 .to_json_line(),
             );
