@@ -148,6 +148,7 @@ fn committed_reports_regenerate_unchanged() {
         "budget",
         "budget-transfer",
         "budget-beam",
+        "borouchaki-finish",
     ] {
         let src = repo_path(&format!("results/{case}"));
         if !src.join("report.md").exists() {
