@@ -145,7 +145,7 @@ fn audited_run(
     });
     let mut s = Searcher::new(mesh, table);
     s.set_tree_audit(Some(audit));
-    let got = s.run(algo.clone(), seed);
+    let got = s.run(algo, seed);
     let audit = AUDIT
         .with(|cell| cell.borrow_mut().take())
         .expect("set above");
