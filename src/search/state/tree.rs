@@ -401,6 +401,13 @@ impl State<'_> {
 
     /// Reverts the last `tree_push`. Panics when nothing was pushed.
     pub fn tree_pop(&mut self) {
+        let c = self.tree_undo();
+        self.audit_tree(TreeEvent::Pop(c));
+    }
+
+    /// [`State::tree_pop`] before the audit hook: returns the candidate popped.
+    #[inline(always)]
+    fn tree_undo(&mut self) -> u32 {
         assert!(!self.tree.is_empty(), "tree_pop with nothing pushed");
         let tr = &mut self.tree;
         let d = tr.path.len() as u32;
@@ -436,8 +443,7 @@ impl State<'_> {
                 }
             }
             self.remaining += 2;
-            self.audit_tree(TreeEvent::Pop(c));
-            return;
+            return c;
         }
         unreachable!("tree log without a TreeApply marker");
     }
