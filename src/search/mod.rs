@@ -84,6 +84,8 @@ struct LazyState<'a> {
     mesh: &'a Mesh,
     table: &'a CandidateTable,
     state: Option<State<'a>>,
+    /// The tree audit hook, set on every state built ([`Searcher::set_tree_audit`]).
+    audit: Option<state::TreeAudit>,
 }
 
 impl<'a> LazyState<'a> {
@@ -95,6 +97,7 @@ impl<'a> LazyState<'a> {
         if self.state.is_none() {
             let mut state = State::new(self.mesh, self.table);
             state.set_forward_uncopied();
+            state.set_tree_audit(self.audit);
             // The work counters count the runs' work, not the initial verdicts'.
             (state.searches, state.searched) = (0, 0);
             self.state = Some(state);
@@ -116,6 +119,7 @@ impl<'a> LazyState<'a> {
         self.state = None;
         let mut state = State::new(self.mesh, self.table);
         state.set_forward(true);
+        state.set_tree_audit(self.audit);
         (state.searches, state.searched, state.split_shrinks) = counters;
         self.state = Some(state);
     }
@@ -177,6 +181,16 @@ impl<'a> Searcher<'a> {
         self.progress = Some(ProgressFn(Box::new(f)));
     }
 
+    /// Calls `audit` after every push and pop of the look-ahead trees of the runs that
+    /// follow (`None` removes it): a test hook, see [`state::TreeView`]. It sees every tree
+    /// node and may query its verdicts; the runs stay the same.
+    pub fn set_tree_audit(&mut self, audit: Option<state::TreeAudit>) {
+        self.state.audit = audit;
+        if let Some(state) = &mut self.state.state {
+            state.set_tree_audit(audit);
+        }
+    }
+
     /// Reports progress to the callback, if any. `quads`: quads made so far.
     pub(crate) fn tick(&mut self, quads: usize) {
         if let Some(ProgressFn(f)) = &mut self.progress {
@@ -207,6 +221,7 @@ impl<'a> Searcher<'a> {
                 mesh,
                 table,
                 state: None,
+                audit: None,
             },
             order,
             rank,

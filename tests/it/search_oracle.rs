@@ -5,6 +5,7 @@
 //! random triangulations. The naive oracle itself is checked on hand-made cases and against a
 //! second, global statement of the same rule.
 
+mod audit;
 mod budgeted;
 mod lazy;
 mod meshes;

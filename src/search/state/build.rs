@@ -185,6 +185,7 @@ impl<'a> State<'a> {
             building: true,
             last_local: NONE,
             last_local_mask: 0,
+            audit: None,
             stamp: vec![0; nt],
             epoch: 0,
             queue: Default::default(),

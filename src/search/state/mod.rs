@@ -53,6 +53,7 @@
 #![allow(clippy::needless_range_loop)] // index loops over the 4 quad sides read best
 
 mod acyclic;
+mod audit;
 mod build;
 mod check;
 mod oracle;
@@ -63,6 +64,7 @@ mod verdicts;
 
 use crate::mesh::Mesh;
 use crate::quality::CandidateTable;
+pub use audit::{TreeAudit, TreeEvent, TreeView};
 pub use oracle::naive_allowed;
 use pk::OrderedSets;
 pub use tree::Near;
@@ -276,6 +278,8 @@ pub struct State<'a> {
     last_local: u32,
     /// The clean quad vertices (bits) of `last_local`'s proof.
     last_local_mask: u8,
+    /// Test hook called after every tree push and pop ([`State::set_tree_audit`]).
+    audit: Option<TreeAudit>,
 
     // ---- scratch ----
     /// Search marks: `epoch << 3 | owner` (owner = search index or `BLOCKED`) for a triangle

@@ -22,6 +22,7 @@
 //! vertices, the base verdicts watching a removed triangle or a merged dead component, and
 //! the base split verdicts (their polder's parity may differ).
 
+use super::TreeEvent;
 use super::check::LOCAL_PROOF;
 use super::{DEAD, KIND_LOCAL, Op, State, Verdict, is_split};
 use crate::mesh::NONE;
@@ -76,7 +77,7 @@ pub(super) struct Overlay {
     /// no tree and needs none of them).
     sizes: (usize, usize, usize),
     /// Actions pushed, and the serial number of the node at each depth (0: the root).
-    path: Vec<u32>,
+    pub(super) path: Vec<u32>,
     serial: Vec<u32>,
     next_serial: u32,
     /// Polder ids whose size changed parity at a split on the path, and how many there
@@ -395,10 +396,18 @@ impl State<'_> {
             tr.touched_log.push(tr.touched_at[v as usize]);
             tr.touched_at[v as usize] = tr.next_serial;
         }
+        self.audit_tree(TreeEvent::Push(c));
     }
 
     /// Reverts the last `tree_push`. Panics when nothing was pushed.
     pub fn tree_pop(&mut self) {
+        let c = self.tree_undo();
+        self.audit_tree(TreeEvent::Pop(c));
+    }
+
+    /// [`State::tree_pop`] before the audit hook: returns the candidate popped.
+    #[inline(always)]
+    fn tree_undo(&mut self) -> u32 {
         assert!(!self.tree.is_empty(), "tree_pop with nothing pushed");
         let tr = &mut self.tree;
         let d = tr.path.len() as u32;
@@ -434,7 +443,7 @@ impl State<'_> {
                 }
             }
             self.remaining += 2;
-            return;
+            return c;
         }
         unreachable!("tree log without a TreeApply marker");
     }
