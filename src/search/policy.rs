@@ -102,9 +102,24 @@ impl Searcher<'_> {
         !out.is_empty()
     }
 
-    /// Pushes `path` (actions from the root) onto the state's tree.
-    pub(super) fn push_path(&mut self, path: &[u32]) {
-        for &c in path {
+    /// Rebuilds in `path` the actions from the root to node `i` of an explicit tree
+    /// (`link(j)`: node `j`'s action and parent, `u32::MAX` above the root's children) and
+    /// pushes them onto the state's tree.
+    pub(super) fn push_path_to(
+        &mut self,
+        path: &mut Vec<u32>,
+        i: u32,
+        link: impl Fn(u32) -> (u32, u32),
+    ) {
+        path.clear();
+        let mut j = i;
+        while j != u32::MAX {
+            let (action, parent) = link(j);
+            path.push(action);
+            j = parent;
+        }
+        path.reverse();
+        for &c in path.iter() {
             self.state.tree_push(c);
         }
     }

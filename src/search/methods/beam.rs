@@ -69,14 +69,9 @@ impl Policy for Beam {
                 next.clear();
                 for &i in &beam {
                     let n = nodes[i as usize];
-                    path.clear();
-                    let mut j = i;
-                    while j != u32::MAX {
-                        path.push(nodes[j as usize].action);
-                        j = nodes[j as usize].parent;
-                    }
-                    path.reverse();
-                    s.push_path(&path);
+                    s.push_path_to(&mut path, i, |j| {
+                        (nodes[j as usize].action, nodes[j as usize].parent)
+                    });
                     let any = s.selective_children(n.key, &mut kids);
                     s.pop_n(path.len());
                     if !any {

@@ -105,14 +105,9 @@ impl Policy for Optimistic {
                     break; // no leaf can beat the best path, nor tie with it
                 }
                 let n = nodes[i as usize];
-                path.clear();
-                let mut j = i;
-                while j != u32::MAX {
-                    path.push(nodes[j as usize].action);
-                    j = nodes[j as usize].parent;
-                }
-                path.reverse();
-                s.push_path(&path);
+                s.push_path_to(&mut path, i, |j| {
+                    (nodes[j as usize].action, nodes[j as usize].parent)
+                });
                 s.selective_children(n.key, &mut kids);
                 s.pop_n(path.len());
                 s.count_node();
