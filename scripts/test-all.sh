@@ -29,6 +29,14 @@ if [ -z "${VK_DRIVER_FILES:-}" ] && [ -n "$lvp" ] && [ "$(ls /usr/share/vulkan/i
   export VK_DRIVER_FILES="$lvp"
 fi
 echo "== Vulkan drivers for the GPU tests: ${VK_DRIVER_FILES:-loader default}"
+# Without a usable XDG_RUNTIME_DIR (CI, containers) Mesa's device-selection layer prints
+# "error: XDG_RUNTIME_DIR is invalid ..." for every Vulkan instance the test process makes.
+# The quadrecomb binary turns that layer off itself (src/main.rs); the test harness is
+# another process, so do the same for it (the test that checks the binary's own switch
+# removes this variable for the commands it runs).
+if [ ! -d "${XDG_RUNTIME_DIR:-/nonexistent}" ] && [ -z "${NODEVICE_SELECT:-}" ]; then
+  export NODEVICE_SELECT=1
+fi
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
