@@ -126,7 +126,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         horizon: args.horizon,
         budget: args.budget,
     };
-    let algo = Algo::new(name, given).map_err(|e| UsageError(e.to_string()))?;
+    let algo = Algo::new(name, given).map_err(|e| match e {
+        // Name the flag that carried the value.
+        search::methods::AlgoError::OutOfRange { param, .. } => {
+            UsageError(format!("--{param}: {e}"))
+        }
+        e => UsageError(e.to_string()),
+    })?;
     for kind in algo.ignored(given) {
         match kind {
             search::methods::ParamKind::Horizon => {

@@ -72,6 +72,13 @@ fn exit_2_usage_error() {
     args.extend(["--threads", "0"]);
     fails_with(tmp.path(), &args, 2, "--threads must be at least 1");
     assert!(!tmp.path().join("a").exists(), "refused before any work");
+    // A method's parameter out of range names the flag that carried it.
+    fails_with(
+        tmp.path(),
+        &["recombine", "sphere", "--algo", "mcts", "--budget", "0"],
+        2,
+        "--budget: mcts: budget 0 is out of range 1..=",
+    );
 }
 
 /// 3: bad input, a mesh file that is not one, and a results directory whose files are not a

@@ -92,6 +92,16 @@ pub enum ParamKind {
     Budget,
 }
 
+/// The parameter's name as records and flags spell it (`horizon`, `budget`).
+impl fmt::Display for ParamKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ParamKind::Horizon => "horizon",
+            ParamKind::Budget => "budget",
+        })
+    }
+}
+
 /// One parameter of a method: its kind, help, default and range (inclusive).
 #[derive(Debug, Clone, Copy)]
 pub struct ParamSpec {
@@ -337,7 +347,7 @@ pub enum AlgoError {
     BadHorizon(String),
     #[error("the horizon must be at least 1")]
     ZeroHorizon,
-    #[error("{method}: {param:?} {value} is out of range {min}..={max}")]
+    #[error("{method}: {param} {value} is out of range {min}..={max}")]
     OutOfRange {
         method: &'static str,
         param: ParamKind,
@@ -346,7 +356,7 @@ pub enum AlgoError {
         max: u32,
     },
     #[error(
-        "{method}: {param:?} {value:?} does not fit the method (it has the parameter: a value; it has not: none)"
+        "{method}: {param} {value:?} does not fit the method (it has the parameter: a value; it has not: none)"
     )]
     Mismatch {
         method: &'static str,
