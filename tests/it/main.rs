@@ -1,6 +1,7 @@
 //! The one integration-test binary: each module tests one area through the library or the CLI.
 
 mod across;
+mod all_quad;
 mod cli_edge;
 mod files;
 mod finish;
