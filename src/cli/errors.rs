@@ -115,6 +115,7 @@ fn experiment_code(e: &ExperimentError) -> Option<u8> {
         | E::ForeignRecords { .. }
         | E::Merge(_)
         | E::TornPart { .. }
+        | E::Finish { .. }
         | E::OptimumContradicted { .. } => Some(EXIT_BAD_INPUT),
         E::Mismatch { .. }
         | E::Extendable { .. }

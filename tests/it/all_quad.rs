@@ -21,7 +21,7 @@ fn valid_table(mesh: &Mesh) -> CandidateTable {
 }
 
 /// `mesh` without the triangles `drop` (unused vertices removed).
-fn without(mesh: &Mesh, drop: &[u32]) -> Mesh {
+pub(crate) fn without(mesh: &Mesh, drop: &[u32]) -> Mesh {
     let gone: std::collections::HashSet<u32> = drop.iter().copied().collect();
     let triangles: Vec<[u32; 3]> = (0..mesh.num_triangles() as u32)
         .filter(|t| !gone.contains(t))
@@ -398,7 +398,7 @@ fn all_quad_names_a_component_no_split_can_fix() {
 // ---------------------------------------------------------------- written files
 
 /// Writes `mesh` (triangles only) to `path`.
-fn write_input(mesh: &Mesh, path: &Path) {
+pub(crate) fn write_input(mesh: &Mesh, path: &Path) {
     let table = valid_table(mesh);
     let rec = quality::recombined(mesh, &table, &[]);
     quadrecomb::internals::mesh::msh::write(path, mesh, &rec).unwrap();
@@ -406,7 +406,7 @@ fn write_input(mesh: &Mesh, path: &Path) {
 
 /// Runs `all_quad_check.py` on `input` and `output`; asserts what it reports and returns
 /// the number of new nodes.
-fn check_written(input: &Path, output: &Path) -> usize {
+pub(crate) fn check_written(input: &Path, output: &Path) -> usize {
     let script = include_str!("all_quad_check.py");
     let line = python(script, &[input, output]);
     let v: serde_json::Value = serde_json::from_str(line.trim()).unwrap();

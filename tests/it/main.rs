@@ -20,6 +20,7 @@ mod runner_extend;
 mod search;
 mod search_oracle;
 mod suite;
+mod sweep_all_quad;
 mod sweep_finish;
 mod util;
 mod valid_output;
