@@ -6,14 +6,14 @@
 //! them (`all_quad_check.py`).
 
 use crate::util::{python, python_module_available, run_in};
-use quadrecomb::internals::finish::{FinishConfig, FinishError, StuckReason, finish};
+use quadrecomb::internals::finish::{FinishConfig, FinishError, Finished, StuckReason, finish};
 use quadrecomb::internals::mesh::generate::{GridSpec, grid, lattice};
 use quadrecomb::internals::mesh::{Mesh, MeshData};
 use quadrecomb::internals::quality::{self, CandidateTable, Rule};
 use quadrecomb::internals::search::{Algo, Searcher, optimum};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The table of `mesh` under the valid-quad rule.
 fn valid_table(mesh: &Mesh) -> CandidateTable {
@@ -192,7 +192,7 @@ fn oracle(mesh: &Mesh) -> (Vec<u32>, Vec<Verdict>) {
 /// Checks all-quad's outcome on `mesh` against the oracle: it succeeds exactly when every
 /// component that keeps triangles is fixable, with one split per such component at most;
 /// otherwise it names exactly the components the oracle cannot fix. True if it succeeded.
-fn agrees_with_oracle(mesh: &Mesh, seed: u64, what: &str) -> bool {
+fn agrees_with_oracle(mesh: &Mesh, seed: u64, what: &str, written: &mut Written) -> bool {
     let (component, verdicts) = oracle(mesh);
     let unfixable: Vec<u32> = verdicts
         .iter()
@@ -247,6 +247,15 @@ fn strictly_convex(p: [[f64; 3]; 4]) -> bool {
 /// (no triangle left, quads strictly convex and a matching, the new mesh valid with one node
 /// and one triangle per split, each node the midpoint of its side), or the error.
 fn all_quad(mesh: &Mesh, seed: u64) -> Result<usize, FinishError> {
+    all_quad_into(mesh, seed, None)
+}
+
+/// [`all_quad`], writing the input and the result into `written` when it succeeds.
+fn all_quad_into(
+    mesh: &Mesh,
+    seed: u64,
+    written: Option<&mut Written>,
+) -> Result<usize, FinishError> {
     let table = valid_table(mesh);
     let run = Searcher::new(mesh, &table).run(Algo::selective(1), seed);
     let config = FinishConfig {
@@ -276,6 +285,9 @@ fn all_quad(mesh: &Mesh, seed: u64) -> Result<usize, FinishError> {
             assert!((n[d] - 0.5 * (a[d] + b[d])).abs() < 1e-12);
         }
     }
+    if let Some(w) = written {
+        w.add(mesh, &f, &table);
+    }
     Ok(f.splits.len())
 }
 
@@ -290,6 +302,7 @@ fn odd_components(mesh: &Mesh) -> usize {
 /// there left an imbalance of two; now the split is placed where the rest stays matchable.
 #[test]
 fn all_quad_pairs_every_triangle_of_the_612_lattice_without_its_corner() {
+    let mut written = Written::new();
     for seed in 0..4u64 {
         let full = lattice(612, seed);
         assert_eq!(full.num_triangles(), 612);
@@ -298,9 +311,11 @@ fn all_quad_pairs_every_triangle_of_the_612_lattice_without_its_corner() {
         let (_, verdicts) = oracle(&mesh);
         assert_eq!(verdicts.len(), 1);
         assert!(verdicts[0].fixable, "seed {seed}: the oracle finds a split");
-        let splits = all_quad(&mesh, seed).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let splits = all_quad_into(&mesh, seed, Some(&mut written))
+            .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         assert_eq!(splits, 1);
     }
+    assert!(matches!(written.check(), 0 | 4));
 }
 
 /// Lattices with several corners or inner triangles removed (holes whose sides are
@@ -309,6 +324,7 @@ fn all_quad_pairs_every_triangle_of_the_612_lattice_without_its_corner() {
 #[test]
 fn all_quad_on_lattices_with_triangles_removed_agrees_with_the_oracle() {
     let (mut ok, mut cases) = (0, 0);
+    let mut written = Written::new();
     for seed in 0..3u64 {
         let full = lattice(400 + 60 * seed as usize, seed);
         let c = corners(&full);
@@ -325,7 +341,8 @@ fn all_quad_on_lattices_with_triangles_removed_agrees_with_the_oracle() {
             vec![inner, inner + 1, inner + 2],
         ] {
             let mesh = without(&full, &drop);
-            let done = agrees_with_oracle(&mesh, seed, &format!("seed {seed}, drop {drop:?}"));
+            let what = format!("seed {seed}, drop {drop:?}");
+            let done = agrees_with_oracle(&mesh, seed, &what, &mut written);
             if drop.len() == 1 && c.contains(&drop[0]) {
                 assert!(done, "seed {seed}: one corner removed");
             }
@@ -335,6 +352,9 @@ fn all_quad_on_lattices_with_triangles_removed_agrees_with_the_oracle() {
     }
     assert_eq!(cases, 21);
     assert!(ok >= 8, "{ok} of {cases} succeeded");
+    // Every success written and checked by meshio (0: meshio missing outside CI).
+    let n = written.check();
+    assert!(n == 0 || n == ok, "{n} checked of {ok}");
 }
 
 /// Property over seeds: small jittered lattices and grids with random triangles removed;
@@ -342,6 +362,7 @@ fn all_quad_on_lattices_with_triangles_removed_agrees_with_the_oracle() {
 #[test]
 fn all_quad_succeeds_exactly_where_a_split_can_fix_every_component() {
     let (mut ok, mut cases) = (0, 0);
+    let mut written = Written::new();
     for seed in 0..24u64 {
         let mut rng = ChaCha8Rng::seed_from_u64(crate::util::SEED ^ seed);
         let base = if seed % 2 == 0 {
@@ -360,11 +381,13 @@ fn all_quad_succeeds_exactly_where_a_split_can_fix_every_component() {
         drop.sort_unstable();
         drop.dedup();
         let mesh = without(&base, &drop);
-        ok += agrees_with_oracle(&mesh, seed, &format!("seed {seed}")) as usize;
+        ok += agrees_with_oracle(&mesh, seed, &format!("seed {seed}"), &mut written) as usize;
         cases += 1;
     }
     // Both outcomes are exercised (random holes often leave an imbalance no split mends).
     assert!(ok >= 4 && cases - ok >= 4, "{ok} of {cases} succeeded");
+    let n = written.check();
+    assert!(n == 0 || n == ok, "{n} checked of {ok}");
 }
 
 /// A component no split can fix: a lone triangle (every side boundary) beside a lattice.
@@ -407,30 +430,90 @@ pub(crate) fn write_input(mesh: &Mesh, path: &Path) {
 /// Runs `all_quad_check.py` on `input` and `output`; asserts what it reports and returns
 /// the number of new nodes.
 pub(crate) fn check_written(input: &Path, output: &Path) -> usize {
+    check_written_all(&[(input.to_path_buf(), output.to_path_buf())])[0]
+}
+
+/// [`check_written`] for many pairs, in one Python process.
+fn check_written_all(pairs: &[(PathBuf, PathBuf)]) -> Vec<usize> {
     let script = include_str!("all_quad_check.py");
-    let line = python(script, &[input, output]);
-    let v: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
-    let what = format!("{}: {v}", output.display());
-    assert_eq!(v["triangles"], 0, "{what}");
-    assert_eq!(v["nonconvex"], 0, "{what}");
-    assert_eq!(v["new_nodes_off_boundary_side"], 0, "{what}");
-    assert_eq!(v["edges_over_two"], 0, "{what}");
-    assert_eq!(v["hanging_edges"], 0, "{what}");
-    let new = v["new_nodes"].as_u64().unwrap();
-    let (tin, qin, q) = (
-        v["input_triangles"].as_u64().unwrap(),
-        v["input_quads"].as_u64().unwrap(),
-        v["quads"].as_u64().unwrap(),
-    );
-    assert_eq!(2 * (q - qin), tin + new, "{what}");
-    let (a, b) = (
-        v["area_in"].as_f64().unwrap(),
-        v["area_out"].as_f64().unwrap(),
-    );
-    // A non-planar quad's (Newell) area is not its two triangles' sum: loose on surfaces.
-    let tol = if v["planar"] == true { 1e-9 } else { 1e-3 };
-    assert!((a - b).abs() <= tol * a.max(1.0), "{what}");
-    new as usize
+    let args: Vec<&Path> = pairs
+        .iter()
+        .flat_map(|(a, b)| [a.as_path(), b.as_path()])
+        .collect();
+    let text = python(script, &args);
+    // meshio may print notes of its own (blank lines included): keep the JSON objects.
+    let lines: Vec<&str> = text.lines().filter(|l| l.starts_with('{')).collect();
+    assert_eq!(lines.len(), pairs.len(), "{text}");
+    pairs
+        .iter()
+        .zip(lines)
+        .map(|((_, output), line)| {
+            let v: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
+            let what = format!("{}: {v}", output.display());
+            assert_eq!(v["triangles"], 0, "{what}");
+            assert_eq!(v["nonconvex"], 0, "{what}");
+            assert_eq!(v["new_nodes_off_boundary_side"], 0, "{what}");
+            assert_eq!(v["edges_over_two"], 0, "{what}");
+            assert_eq!(v["hanging_edges"], 0, "{what}");
+            let new = v["new_nodes"].as_u64().unwrap();
+            let (tin, qin, q) = (
+                v["input_triangles"].as_u64().unwrap(),
+                v["input_quads"].as_u64().unwrap(),
+                v["quads"].as_u64().unwrap(),
+            );
+            assert_eq!(2 * (q - qin), tin + new, "{what}");
+            let (a, b) = (
+                v["area_in"].as_f64().unwrap(),
+                v["area_out"].as_f64().unwrap(),
+            );
+            // A non-planar quad's (Newell) area is not its two triangles' sum: loose on
+            // surfaces.
+            let tol = if v["planar"] == true { 1e-9 } else { 1e-3 };
+            assert!((a - b).abs() <= tol * a.max(1.0), "{what}");
+            new as usize
+        })
+        .collect()
+}
+
+/// The all-quad results of a test written as .msh (input and finished mesh, by our writer),
+/// checked by meshio in one go at the end.
+struct Written {
+    dir: tempfile::TempDir,
+    pairs: Vec<(PathBuf, PathBuf)>,
+    splits: Vec<usize>,
+}
+
+impl Written {
+    fn new() -> Written {
+        Written {
+            dir: tempfile::tempdir().unwrap(),
+            pairs: Vec::new(),
+            splits: Vec::new(),
+        }
+    }
+
+    fn add(&mut self, input: &Mesh, f: &Finished, table: &CandidateTable) {
+        let k = self.pairs.len();
+        let (a, b) = (
+            self.dir.path().join(format!("in{k}.msh")),
+            self.dir.path().join(format!("out{k}.msh")),
+        );
+        write_input(input, &a);
+        let rec = quality::recombined(f.mesh(input), f.table(table), &f.chosen);
+        quadrecomb::internals::mesh::msh::write(&b, f.mesh(input), &rec).unwrap();
+        self.pairs.push((a, b));
+        self.splits.push(f.splits.len());
+    }
+
+    /// Checks every file written; returns how many.
+    fn check(&self) -> usize {
+        if self.pairs.is_empty() || !python_module_available("meshio") {
+            return 0;
+        }
+        let new = check_written_all(&self.pairs);
+        assert_eq!(new, self.splits, "one new node per split");
+        new.len()
+    }
 }
 
 /// `recombine --finish --all-quad -o` on lattices with corners removed writes only strictly
@@ -544,7 +627,12 @@ fn all_quad_refuses_on_odd_pieces_only_what_the_oracle_cannot_fix() {
             .unwrap(),
     )
     .unwrap();
-    assert!(!agrees_with_oracle(&mesh, 0, "odd-pieces"));
+    assert!(!agrees_with_oracle(
+        &mesh,
+        0,
+        "odd-pieces",
+        &mut Written::new()
+    ));
 }
 
 /// A mesh no split can fix: the command fails with exit code 3 and names the element.
