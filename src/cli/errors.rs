@@ -93,6 +93,10 @@ fn code(e: &(dyn Error + 'static)) -> Option<u8> {
     if let Some(e) = e.downcast_ref::<ExperimentError>() {
         return experiment_code(e);
     }
+    if let Some(quadrecomb::internals::finish::FinishError::NotAllQuad(_)) = e.downcast_ref() {
+        // The mesh has a component no boundary split can make all-quad.
+        return Some(EXIT_BAD_INPUT);
+    }
     match e.downcast_ref::<ReportError>()? {
         ReportError::NotResults { .. } | ReportError::NoRuns { .. } => Some(EXIT_BAD_INPUT),
         ReportError::NoSuchPicture(..) | ReportError::NoSuchBaseline(..) => Some(EXIT_USAGE),
@@ -111,6 +115,7 @@ fn experiment_code(e: &ExperimentError) -> Option<u8> {
         | E::ForeignRecords { .. }
         | E::Merge(_)
         | E::TornPart { .. }
+        | E::Finish { .. }
         | E::OptimumContradicted { .. } => Some(EXIT_BAD_INPUT),
         E::Mismatch { .. }
         | E::Extendable { .. }

@@ -166,7 +166,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let finished = match args.finish.config(rule) {
         Some(config) => Some(
             quadrecomb::internals::finish::finish(&mesh, &table, &out.chosen, config)
-                .map_err(|e| anyhow::anyhow!("{}: all-quad split: {e}", args.mesh))?,
+                .map_err(|e| anyhow::Error::new(e).context(args.mesh.clone()))?,
         ),
         None => None,
     };

@@ -1,6 +1,7 @@
 //! `quadrecomb replay DIR [RUN]`: one recorded run of a sweep re-run with the record's mesh,
 //! eta and rule (through [`quadrecomb::internals::experiment::replay`], as the report's pictures), checked
-//! against its record, and optionally written as `.msh` / `.vtu`.
+//! against its record, and optionally written as `.msh` / `.vtu` (a finished run's finished
+//! mesh: with all-quad, the split mesh rebuilt from the record).
 
 use super::UsageError;
 use quadrecomb::internals::experiment::replay::{self, EtaCheck, Replayer};
@@ -139,7 +140,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let out = replayer.replay(record).map_err(cannot)?;
     let write = args.out.output.as_ref().filter(|_| out.reproduced);
     if let Some(path) = write {
-        super::write_mesh_output(path, out.mesh, &out.recombined, args.out.vtu_ascii)?;
+        // A finished run writes its finished mesh (the split mesh with all-quad).
+        match &out.finished {
+            Some(f) => {
+                let mesh = f.mesh.as_ref().unwrap_or(out.mesh);
+                super::write_mesh_output(path, mesh, &f.recombined, args.out.vtu_ascii)?;
+            }
+            None => super::write_mesh_output(path, out.mesh, &out.recombined, args.out.vtu_ascii)?,
+        }
     }
     let typical = matches!(which, Which::Typical);
     let rule = record.rule();
@@ -224,6 +232,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 f.time_s,
                 rf.time_s
             );
+            if let Some(a) = f.all_quad {
+                println!(
+                    "all-quad        {} boundary sides split, {} nodes added {} (recorded {})",
+                    a.splits,
+                    a.nodes_added,
+                    super::finish_report::SPLIT_PLACE,
+                    rf.splits()
+                );
+            }
         }
         let same = if out.reproduced { "yes" } else { "no" };
         println!("reproduced      {same}");

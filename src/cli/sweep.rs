@@ -132,6 +132,12 @@ pub struct SweepFinishArgs {
     /// With --finish: rings of quads of each improvement window (r); 0 skips improvement.
     #[arg(long, requires = "finish", default_value_t = quadrecomb::internals::finish::DEFAULT_WINDOW)]
     window: u32,
+    /// With --finish: also make odd components even by splitting a boundary side (a new node
+    /// at its midpoint, on the chord), so that no triangle is left. Records then count the
+    /// split mesh's triangles and add `finish.all_quad` (splits, nodes added); replay
+    /// rebuilds the split mesh from the record.
+    #[arg(long, requires = "finish")]
+    all_quad: bool,
 }
 
 /// The sweep's own files that exist in `dir` (runs, manifest, summaries), by role, for a
@@ -252,6 +258,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             quadrecomb::internals::experiment::finished::FinishSettings {
                 rings: args.finish.rings,
                 window: args.finish.window,
+                all_quad: args.finish.all_quad,
             },
         ),
     })

@@ -167,16 +167,22 @@ pub fn check_records(
                 ),
             });
         }
-        let finished = r.finish.as_ref().map(|f| (f.rings, f.window));
+        let finished = r
+            .finish
+            .as_ref()
+            .map(|f| (f.rings, f.window, f.all_quad.is_some()));
         let wanted = manifest
             .spec
             .finish
             .filter(|_| super::record::is_search(&r.algo))
-            .map(|s| (s.rings, s.window));
+            .map(|s| (s.rings, s.window, s.all_quad));
         if finished != wanted {
-            let say = |f: Option<(u32, u32)>| {
-                f.map_or("no finish".to_string(), |(k, w)| {
-                    format!("finish rings {k} window {w}")
+            let say = |f: Option<(u32, u32, bool)>| {
+                f.map_or("no finish".to_string(), |(k, w, a)| {
+                    format!(
+                        "finish rings {k} window {w}{}",
+                        if a { " all-quad" } else { "" }
+                    )
                 })
             };
             return Err(ExperimentError::ForeignRecords {
@@ -290,7 +296,7 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
     if let Some(f) = &r.finish {
         f.check(r.triangles)?;
         if let Some(opt) = optimum {
-            if f.quads > opt.quads {
+            if f.quads > opt.quads + f.splits() {
                 return Err(format!(
                     "finish: {} quads, more than the {} of its mesh's optimum",
                     f.quads, opt.quads

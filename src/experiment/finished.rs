@@ -1,14 +1,20 @@
 //! `sweep --finish`: each search run finished after its search ([`crate::internals::finish::finish`],
-//! leftover elimination then local improvement, no all-quad), and what its record keeps of
-//! the finish. The raw fields of a record stay the search's; the finish is one optional
+//! leftover elimination, all-quad splits with `--all-quad`, then local improvement), and what
+//! its record keeps of the finish. A split mesh is not stored: replay rebuilds it from the
+//! record (seed, rule, finish settings), the finish being deterministic. The raw fields of a record stay the search's; the finish is one optional
 //! object beside them (absent without `--finish`, so older records read and write as they
 //! did). See docs/finish.md and docs/runner.md.
 
 use serde::{Deserialize, Serialize};
 
-use crate::internals::finish::{FinishConfig, finish};
+use crate::internals::finish::{FinishConfig, FinishError, finish};
 use crate::mesh::Mesh;
-use crate::quality::{CandidateTable, ElementQuality, Rule};
+use crate::mesh::Recombined;
+use crate::quality::{CandidateTable, ElementQuality, Rule, recombined};
+
+fn is_false(b: &bool) -> bool {
+    !*b
+}
 
 /// The finish settings of a sweep (its manifest's `spec.finish`): part of what fixes the
 /// results, so a resume or extension with others is refused.
@@ -18,6 +24,10 @@ pub struct FinishSettings {
     pub rings: u32,
     /// Rings of each improvement window (r; 0 skips improvement).
     pub window: u32,
+    /// Make odd components even by boundary splits (`--all-quad`); absent when false, so
+    /// manifests without it read and write as before.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub all_quad: bool,
 }
 
 impl Default for FinishSettings {
@@ -25,13 +35,18 @@ impl Default for FinishSettings {
         FinishSettings {
             rings: crate::internals::finish::DEFAULT_RINGS,
             window: crate::internals::finish::DEFAULT_WINDOW,
+            all_quad: false,
         }
     }
 }
 
 impl std::fmt::Display for FinishSettings {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "finish rings {} window {}", self.rings, self.window)
+        write!(f, "finish rings {} window {}", self.rings, self.window)?;
+        if self.all_quad {
+            write!(f, " all-quad")?;
+        }
+        Ok(())
     }
 }
 
@@ -50,32 +65,81 @@ pub struct FinishOutcome {
     pub improve_s: f64,
     /// The finished quads' eta figures.
     pub elements: ElementQuality,
+    /// What all-quad did (with `all_quad` settings only).
+    pub all_quad: Option<AllQuadFigures>,
 }
 
-/// Finishes the pairing `chosen` (a search's) of `mesh` under `rule` with `settings`.
+/// What all-quad did to one run: the record's `finish.all_quad` object.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AllQuadFigures {
+    /// Boundary sides split (one per odd component that kept a triangle).
+    pub splits: usize,
+    /// Nodes added to the mesh (one per split, on the chord of the side).
+    pub nodes_added: usize,
+    /// Seconds of all-quad (the choice of the splits, the new mesh, its elimination).
+    pub time_s: f64,
+}
+
+/// The finished mesh of a run: the split mesh when all-quad split (else `None`: the input),
+/// and its elements.
+#[derive(Debug, Clone)]
+pub struct FinishedMesh {
+    /// The split mesh, when all-quad split sides.
+    pub mesh: Option<Mesh>,
+    /// The finished quads and the triangles left, on that mesh.
+    pub recombined: Recombined,
+}
+
+/// Finishes the pairing `chosen` (a search's) of `mesh` under `rule` with `settings`. Fails
+/// only with all-quad, when a component keeps triangles no boundary split can pair.
 pub fn finish_run(
     mesh: &Mesh,
     table: &CandidateTable,
     chosen: &[u32],
     settings: FinishSettings,
     rule: Rule,
-) -> FinishOutcome {
+) -> Result<FinishOutcome, FinishError> {
+    finish_run_with_mesh(mesh, table, chosen, settings, rule).map(|(o, _)| o)
+}
+
+/// [`finish_run`], and the finished mesh (for writing it).
+pub fn finish_run_with_mesh(
+    mesh: &Mesh,
+    table: &CandidateTable,
+    chosen: &[u32],
+    settings: FinishSettings,
+    rule: Rule,
+) -> Result<(FinishOutcome, FinishedMesh), FinishError> {
     let config = FinishConfig {
         rings: settings.rings.max(1),
         window: settings.window,
-        all_quad: false,
+        all_quad: settings.all_quad,
         rule,
     };
-    // Without all-quad the mesh is never rebuilt, the one way `finish` fails.
-    let f = finish(mesh, table, chosen, config).expect("a finish without all-quad cannot fail");
-    FinishOutcome {
+    let f = finish(mesh, table, chosen, config)?;
+    let t = f.table(table);
+    let outcome = FinishOutcome {
         quads: f.improved.quads,
         triangles_left: f.improved.triangles_left,
         quality: f.improved.quality,
         eliminate_s: f.eliminated.time_s,
         improve_s: f.improved.time_s,
-        elements: ElementQuality::of_chosen(table, &f.chosen),
-    }
+        elements: ElementQuality::of_chosen(t, &f.chosen),
+        all_quad: f.all_quad.map(|s| AllQuadFigures {
+            splits: f.splits.len(),
+            nodes_added: f.splits.len(),
+            time_s: s.time_s,
+        }),
+    };
+    let rec = recombined(f.mesh(mesh), t, &f.chosen);
+    let split_mesh = f.mesh;
+    Ok((
+        outcome,
+        FinishedMesh {
+            mesh: split_mesh,
+            recombined: rec,
+        },
+    ))
 }
 
 /// The `finish` object of a record: the run after its finish.
@@ -103,9 +167,13 @@ pub struct FinishRecord {
     pub eliminate_s: f64,
     /// Seconds of local improvement.
     pub improve_s: f64,
-    /// Seconds of the whole finish (elimination + improvement); the search's own time stays
-    /// in the record's `time_s`.
+    /// Seconds of the whole finish (elimination, all-quad, improvement); the search's own
+    /// time stays in the record's `time_s`.
     pub time_s: f64,
+    /// What all-quad did (`sweep --finish --all-quad` only; absent otherwise). With splits,
+    /// the counts above are of the split mesh (`triangles + splits` triangles).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub all_quad: Option<AllQuadFigures>,
 }
 
 impl FinishRecord {
@@ -117,6 +185,7 @@ impl FinishRecord {
         triangles: usize,
         optimum: Option<f64>,
     ) -> FinishRecord {
+        let triangles = triangles + out.all_quad.map_or(0, |a| a.splits);
         FinishRecord {
             rings: settings.rings,
             window: settings.window,
@@ -135,8 +204,14 @@ impl FinishRecord {
             mean_eta: out.elements.mean,
             eliminate_s: out.eliminate_s,
             improve_s: out.improve_s,
-            time_s: out.eliminate_s + out.improve_s,
+            time_s: out.eliminate_s + out.all_quad.map_or(0.0, |a| a.time_s) + out.improve_s,
+            all_quad: out.all_quad,
         }
+    }
+
+    /// Triangles added by all-quad's splits (0 without).
+    pub fn splits(&self) -> usize {
+        self.all_quad.map_or(0, |a| a.splits)
     }
 
     /// The object with its times zeroed (for comparing results, not executions).
@@ -145,6 +220,7 @@ impl FinishRecord {
             eliminate_s: 0.0,
             improve_s: 0.0,
             time_s: 0.0,
+            all_quad: self.all_quad.map(|a| AllQuadFigures { time_s: 0.0, ..a }),
             ..self.clone()
         }
     }
@@ -152,10 +228,21 @@ impl FinishRecord {
     /// Why the object holds values no finish of a run on `triangles` triangles can have
     /// (counts that do not add up, measures out of range), if it does.
     pub fn check(&self, triangles: usize) -> Result<(), String> {
-        if 2 * self.quads as u128 + self.triangles_left as u128 != triangles as u128 {
+        let splits = self.splits();
+        if 2 * self.quads as u128 + self.triangles_left as u128
+            != triangles as u128 + splits as u128
+        {
             return Err(format!(
-                "finish: 2 x {} quads + {} triangles left is not its {triangles} triangles",
+                "finish: 2 x {} quads + {} triangles left is not its {triangles} triangles + {splits} split",
                 self.quads, self.triangles_left
+            ));
+        }
+        if let Some(a) = self.all_quad
+            && (a.nodes_added != a.splits || !a.time_s.is_finite() || a.time_s < 0.0)
+        {
+            return Err(format!(
+                "finish: all_quad {} nodes added for {} splits, time {}",
+                a.nodes_added, a.splits, a.time_s
             ));
         }
         for (name, v) in [

@@ -124,6 +124,18 @@ pub enum ExperimentError {
     /// The sweep configuration is invalid.
     #[error("{0}")]
     Invalid(String),
+    /// A run's finish failed (`--all-quad`: a component keeps triangles no boundary split
+    /// pairs, which every run on that mesh meets).
+    #[error("finishing the run of seed {seed} on mesh {mesh}")]
+    Finish {
+        /// The mesh's name.
+        mesh: String,
+        /// The run's seed.
+        seed: u64,
+        /// The cause.
+        #[source]
+        source: crate::internals::finish::FinishError,
+    },
     /// Computing qualities failed.
     #[error("computing quad qualities")]
     Gpu(#[from] crate::gpu::GpuError),

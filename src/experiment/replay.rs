@@ -107,6 +107,9 @@ pub enum ReplayError {
         /// The first loading error.
         why: String,
     },
+    /// The run's finish failed again (all-quad: a component no boundary split pairs).
+    #[error("cannot finish the run again: {0}")]
+    Finish(String),
 }
 
 /// How the eta table of a replay compares with the sweep's.
@@ -173,6 +176,9 @@ pub struct Replayed<'a> {
     /// The replayed run finished again with the record's settings, when the record has a
     /// `finish` object (`sweep --finish`): its figures in the record's form.
     pub finish: Option<super::finished::FinishRecord>,
+    /// The finished mesh and its elements, when the record has a `finish` object: with
+    /// all-quad, the split mesh rebuilt from the record (what `replay -o` writes).
+    pub finished: Option<super::finished::FinishedMesh>,
 }
 
 impl Replayed<'_> {
@@ -234,23 +240,37 @@ impl<'m> Replayer<'m> {
         let same = |q: usize, x: f64, rq: usize, rx: f64| {
             q == rq && (x - rx).abs() <= 1e-9 * rx.abs().max(1.0)
         };
-        let finish = record.finish.as_ref().map(|f| {
-            let settings = super::finished::FinishSettings {
-                rings: f.rings,
-                window: f.window,
-            };
-            let out =
-                super::finished::finish_run(&p.mesh, &p.table, &chosen, settings, record.rule());
-            // The optimum the record's percentage was taken against.
-            let optimum = record
-                .quality_pct
-                .filter(|&pct| pct > 0.0)
-                .map(|pct| 100.0 * record.quality / pct);
-            super::finished::FinishRecord::new(settings, &out, record.triangles, optimum)
-        });
+        let (finish, finished) = match record.finish.as_ref() {
+            Some(f) => {
+                let settings = super::finished::FinishSettings {
+                    rings: f.rings,
+                    window: f.window,
+                    all_quad: f.all_quad.is_some(),
+                };
+                let (out, finished) = super::finished::finish_run_with_mesh(
+                    &p.mesh,
+                    &p.table,
+                    &chosen,
+                    settings,
+                    record.rule(),
+                )
+                .map_err(|e| ReplayError::Finish(e.to_string()))?;
+                // The optimum the record's percentage was taken against.
+                let optimum = record
+                    .quality_pct
+                    .filter(|&pct| pct > 0.0)
+                    .map(|pct| 100.0 * record.quality / pct);
+                let rec =
+                    super::finished::FinishRecord::new(settings, &out, record.triangles, optimum);
+                (Some(rec), Some(finished))
+            }
+            None => (None, None),
+        };
         let reproduced = same(quads, quality, record.quads, record.quality)
             && match (&finish, &record.finish) {
-                (Some(a), Some(b)) => same(a.quads, a.quality, b.quads, b.quality),
+                (Some(a), Some(b)) => {
+                    same(a.quads, a.quality, b.quads, b.quality) && a.splits() == b.splits()
+                }
                 _ => true,
             };
         Ok(Replayed {
@@ -266,6 +286,7 @@ impl<'m> Replayer<'m> {
             eta_check: p.check,
             reproduced,
             finish,
+            finished,
         })
     }
 

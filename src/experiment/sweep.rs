@@ -256,6 +256,7 @@ pub struct SearchFactory<'a> {
     optimum: &'a [OptimumEntry],
     finish: Option<super::finished::FinishSettings>,
     rule: crate::quality::Rule,
+    names: Vec<&'a str>,
 }
 
 impl<'a> SearchFactory<'a> {
@@ -267,6 +268,9 @@ impl<'a> SearchFactory<'a> {
             optimum: &prepared.manifest.optimum,
             finish: prepared.manifest.spec.finish,
             rule: prepared.manifest.spec.rule(),
+            names: (prepared.manifest.spec.meshes.iter())
+                .map(|m| m.name.as_str())
+                .collect(),
         }
     }
 }
@@ -303,13 +307,15 @@ impl Worker for SearchWorker<'_> {
         let mut outcome = Outcome::of_run(&out, &f.tables[job.mesh]);
         if let Some(settings) = f.finish {
             let (mesh, table) = (&f.meshes[job.mesh], &f.tables[job.mesh]);
-            outcome.finish = Some(super::finished::finish_run(
-                mesh,
-                table,
-                &out.chosen,
-                settings,
-                f.rule,
-            ));
+            outcome.finish = Some(
+                super::finished::finish_run(mesh, table, &out.chosen, settings, f.rule).map_err(
+                    |source| ExperimentError::Finish {
+                        mesh: f.names[job.mesh].to_string(),
+                        seed: job.seed,
+                        source,
+                    },
+                )?,
+            );
         }
         Ok(outcome)
     }

@@ -1,10 +1,13 @@
-//! All-quad: a leftover that recombination alone must keep (one per odd component) is moved
-//! along an alternating path to a triangle with a side on the mesh boundary, and that side is
-//! split at its midpoint by a new node: the triangle becomes two, the component even, and
-//! leftover elimination can pair them with their neighbours. The node lies on the chord (the
-//! straight side): no boundary-curve geometry is read from the input.
+//! All-quad: one triangle per odd component must stay under recombination alone. A
+//! boundary side of a well-chosen triangle `s` is split at its midpoint by a new node: `s`
+//! becomes two halves, the component even, and the halves pair with the triangles across
+//! `s`'s two inner sides. Which triangle is chosen, and why, is [`super::split_choice`]'s
+//! part; this module builds the split mesh, its candidate table and the pairing carried
+//! over. The node lies on the chord (the straight side): no boundary-curve geometry is read
+//! from the input.
 
 use super::region::Pairing;
+use super::split_choice::Chosen;
 use crate::mesh::{Mesh, MeshData, MeshError, NONE};
 use crate::quality::{CandidateTable, Rule, quad_eta};
 
@@ -17,153 +20,12 @@ pub struct Split {
     pub side: [u64; 2],
     /// The new node's tag.
     pub node: u64,
-    /// Triangles moved along the alternating path (0: the leftover itself was on the
-    /// boundary).
+    /// Pairs crossed from the component's leftover to the split triangle (0: the leftover
+    /// itself was split).
     pub path_len: usize,
 }
 
-/// The boundary side of `t` to split, if it has one that works: a side used by no other
-/// element (sides next to another surface or an input quad are no boundary) whose halves
-/// would each make a quad `rule` allows with the triangle across their other inner side;
-/// the longest such side.
-fn boundary_side(mesh: &Mesh, is_boundary: &[bool], rule: Rule, t: u32) -> Option<usize> {
-    let tri = mesh.triangles[t as usize];
-    let at = |v: u32| mesh.vertices[v as usize];
-    // The vertex of the triangle across side `j` of `t` opposite that side.
-    let across = |j: usize| -> Option<u32> {
-        let u = mesh.topology.neighbours[t as usize][j];
-        if u == NONE {
-            return None;
-        }
-        let (a, b) = (tri[j], tri[(j + 1) % 3]);
-        mesh.triangles[u as usize]
-            .into_iter()
-            .find(|&v| v != a && v != b)
-    };
-    let len = |k: usize| {
-        let (a, b) = (at(tri[k]), at(tri[(k + 1) % 3]));
-        (0..3).map(|d| (a[d] - b[d]).powi(2)).sum::<f64>()
-    };
-    (0..3)
-        .filter(|&i| {
-            mesh.topology.neighbours[t as usize][i] == NONE
-                && is_boundary[mesh.topology.triangle_edges[t as usize][i] as usize]
-        })
-        .filter(|&i| {
-            let (p, q, s) = (tri[i], tri[(i + 1) % 3], tri[(i + 2) % 3]);
-            let (pp, pq) = (at(p), at(q));
-            let m: [f64; 3] = std::array::from_fn(|d| 0.5 * (pp[d] + pq[d]));
-            let (Some(o_qs), Some(o_sp)) = (across((i + 1) % 3), across((i + 2) % 3)) else {
-                return false;
-            };
-            // Half (p, m, s) with the triangle across s-p; half (m, q, s) across q-s.
-            let first = quad_eta([at(s), at(o_sp), pp, m]);
-            let second = quad_eta([pq, at(o_qs), at(s), m]);
-            rule.allows(first) && rule.allows(second)
-        })
-        .max_by(|&i, &j| len(i).total_cmp(&len(j)))
-}
-
-/// Moves the leftover `t` to the nearest triangle (in alternating steps) with a boundary side
-/// not yet taken, flipping the pairs on the way. Returns that triangle and the path length.
-fn move_to_boundary(
-    mesh: &Mesh,
-    table: &CandidateTable,
-    pairing: &mut Pairing,
-    is_boundary: &[bool],
-    taken: &[bool],
-    rule: Rule,
-    t: u32,
-) -> Option<(u32, usize, usize)> {
-    use std::collections::HashMap;
-    // parent[even] = (previous even triangle, candidate from it to the odd one).
-    let mut parent: HashMap<u32, (u32, u32)> = HashMap::new();
-    let mut seen: std::collections::HashSet<u32> = std::collections::HashSet::new();
-    let mut queue = std::collections::VecDeque::from([t]);
-    seen.insert(t);
-    let mut target = None;
-    while let Some(x) = queue.pop_front() {
-        if !taken[x as usize]
-            && let Some(side) = boundary_side(mesh, is_boundary, rule, x)
-        {
-            target = Some((x, side));
-            break;
-        }
-        for c in table.by_triangle[x as usize] {
-            if c == NONE {
-                continue;
-            }
-            let u = table.other(c, x);
-            let mu = pairing.mate(table, u);
-            if mu == NONE || seen.contains(&u) || seen.contains(&mu) {
-                continue;
-            }
-            seen.insert(u);
-            seen.insert(mu);
-            parent.insert(mu, (x, c));
-            queue.push_back(mu);
-        }
-    }
-    let Some((b, side)) = target else {
-        return nearest_boundary(mesh, table, pairing, is_boundary, taken, rule, t);
-    };
-    let mut path = Vec::new();
-    let mut cur = b;
-    while cur != t {
-        let (x, c) = parent[&cur];
-        path.push((x, c));
-        cur = x;
-    }
-    pairing.cand[b as usize] = NONE;
-    for &(x, c) in &path {
-        let u = table.other(c, x);
-        pairing.cand[x as usize] = c;
-        pairing.cand[u as usize] = c;
-    }
-    Some((b, side, path.len()))
-}
-
-/// When no alternating path (found without shrinking blossoms) reaches a boundary side that
-/// works: the nearest triangle of the component with one, through any pairs; it and its mate
-/// are unpaired, and elimination then re-pairs the leftover, them and the halves exactly
-/// (through blossoms too).
-fn nearest_boundary(
-    mesh: &Mesh,
-    table: &CandidateTable,
-    pairing: &mut Pairing,
-    is_boundary: &[bool],
-    taken: &[bool],
-    rule: Rule,
-    t: u32,
-) -> Option<(u32, usize, usize)> {
-    let mut dist = std::collections::HashMap::from([(t, 0usize)]);
-    let mut queue = std::collections::VecDeque::from([t]);
-    while let Some(x) = queue.pop_front() {
-        if !taken[x as usize]
-            && let Some(side) = boundary_side(mesh, is_boundary, rule, x)
-        {
-            let m = pairing.mate(table, x);
-            pairing.cand[x as usize] = NONE;
-            if m != NONE {
-                pairing.cand[m as usize] = NONE;
-            }
-            return Some((x, side, dist[&x]));
-        }
-        let d = dist[&x];
-        for c in table.by_triangle[x as usize] {
-            if c != NONE {
-                let u = table.other(c, x);
-                if let std::collections::hash_map::Entry::Vacant(e) = dist.entry(u) {
-                    e.insert(d + 1);
-                    queue.push_back(u);
-                }
-            }
-        }
-    }
-    None
-}
-
-/// The result of [`split_leftovers`].
+/// The result of [`split`].
 pub(crate) struct SplitMesh {
     pub mesh: Mesh,
     pub table: CandidateTable,
@@ -171,25 +33,19 @@ pub(crate) struct SplitMesh {
     pub splits: Vec<Split>,
 }
 
-/// Moves each of `leftovers` to the boundary and splits a boundary side of the triangle it
-/// lands on; the new mesh, its table under `rule` (eta of the pairs that did not change kept
-/// from `table`, new pairs in f64; the two halves of a split are never a pair: their quad has
-/// a straight angle) and the pairing carried over. `None` when no leftover reaches a boundary.
-/// Triangles marked in `excluded` are not split.
-pub(crate) fn split_leftovers(
+/// Splits the boundary sides `chosen` picked: the new mesh, its table under `rule` (eta of
+/// the pairs that did not change kept from `table`, new pairs in f64; the two halves of a
+/// split are never a pair: their quad has a straight angle) and `chosen`'s pairing carried
+/// over, with each half paired with the triangle across its inner side where the new table
+/// has that pair.
+pub(crate) fn split(
     mesh: &Mesh,
     table: &CandidateTable,
-    pairing: &mut Pairing,
-    leftovers: &[u32],
+    chosen: &Chosen,
     rule: Rule,
-    excluded: &[bool],
-) -> Result<Option<SplitMesh>, MeshError> {
-    let mut is_boundary = vec![false; mesh.topology.edges.len()];
-    for &e in &mesh.topology.boundary_edges {
-        is_boundary[e as usize] = true;
-    }
+) -> Result<SplitMesh, MeshError> {
     let nt = mesh.num_triangles();
-    let mut taken = excluded.to_vec();
+    let pairing = &chosen.pairing;
     let mut data = MeshData {
         vertices: mesh.vertices.clone(),
         vertex_ids: mesh.vertex_ids.clone(),
@@ -201,19 +57,14 @@ pub(crate) fn split_leftovers(
         quad_surface: mesh.quad_surface.clone(),
         model: mesh.model.clone(),
     };
-    let mut next_node = mesh.vertex_ids.iter().max().copied().unwrap_or(0) + 1;
-    let mut next_element = mesh.triangle_ids.iter().max().copied().unwrap_or(0) + 1;
+    let first_node = mesh.vertex_ids.iter().max().copied().unwrap_or(0) + 1;
+    let first_element = mesh.triangle_ids.iter().max().copied().unwrap_or(0) + 1;
     let mut splits = Vec::new();
-    for &t in leftovers {
-        if pairing.cand[t as usize] != NONE {
-            continue;
-        }
-        let Some((b, side, path_len)) =
-            move_to_boundary(mesh, table, pairing, &is_boundary, &taken, rule, t)
-        else {
-            continue;
-        };
-        taken[b as usize] = true;
+    // (first half, the triangle across its inner side), (second half, ...) per split.
+    let mut half_pairs = Vec::new();
+    for (k, choice) in chosen.choices.iter().enumerate() {
+        let (next_node, next_element) = (first_node + k as u64, first_element + k as u64);
+        let (b, side) = (choice.triangle, choice.side);
         let tri = mesh.triangles[b as usize];
         let (p, q, s) = (tri[side], tri[(side + 1) % 3], tri[(side + 2) % 3]);
         let (pp, pq) = (mesh.vertices[p as usize], mesh.vertices[q as usize]);
@@ -226,6 +77,7 @@ pub(crate) fn split_leftovers(
         new_tri[(side + 1) % 3] = m;
         new_tri[(side + 2) % 3] = s;
         data.triangles[b as usize] = new_tri;
+        let second = data.triangles.len() as u32;
         data.triangles.push([m, q, s]);
         data.triangle_ids.push(next_element);
         data.triangle_surface
@@ -233,17 +85,15 @@ pub(crate) fn split_leftovers(
         if let Some(model) = data.model.as_deref_mut() {
             split_model_edge(model, p, q, m, mesh.triangle_surface[b as usize]);
         }
+        let nb = mesh.topology.neighbours[b as usize];
+        half_pairs.push((b, nb[(side + 2) % 3]));
+        half_pairs.push((second, nb[(side + 1) % 3]));
         splits.push(Split {
             triangle: b,
             side: [mesh.vertex_ids[p as usize], mesh.vertex_ids[q as usize]],
             node: next_node,
-            path_len,
+            path_len: choice.steps,
         });
-        next_node += 1;
-        next_element += 1;
-    }
-    if splits.is_empty() {
-        return Ok(None);
     }
     let new_mesh = Mesh::new(data)?;
     // Old candidate of each pair of old triangles, to carry eta and the rule's verdict over.
@@ -285,7 +135,7 @@ pub(crate) fn split_leftovers(
         *kept = rule.allows(eta) && !halves;
     }
     let new_table = new_table.retain(&keep);
-    let mut chosen = Vec::new();
+    let mut chosen: Vec<u32> = Vec::new();
     for (t, &c) in pairing.cand.iter().enumerate() {
         if c == NONE || table.pairs[c as usize][0] != t as u32 {
             continue;
@@ -297,13 +147,21 @@ pub(crate) fn split_leftovers(
             .expect("an unsplit pair stays a candidate");
         chosen.push(nc);
     }
+    for (half, other) in half_pairs {
+        if let Some(nc) = new_table.by_triangle[half as usize]
+            .into_iter()
+            .find(|&n| n != NONE && new_table.other(n, half) == other)
+        {
+            chosen.push(nc);
+        }
+    }
     let new_pairing = Pairing::new(new_mesh.num_triangles(), &new_table, &chosen);
-    Ok(Some(SplitMesh {
+    Ok(SplitMesh {
         mesh: new_mesh,
         table: new_table,
         pairing: new_pairing,
         splits,
-    }))
+    })
 }
 
 /// Splits the model's line element on side `p`-`q` (if any) at the new node `m`, and

@@ -6,15 +6,18 @@
 //! Steps, in order: `leftovers` (each group of leftovers with k rings of quads around it,
 //! k doubling until every leftover that can be paired is, or its component is proven to
 //! leave it), [`all_quad`] (optional: one leftover per odd component moved to the boundary,
-//! a boundary side split, eliminated again), `improve` (windows of r rings swept until a
+//! a boundary side split where [`split_choice`] proves it makes the component perfectly
+//! matchable, eliminated again), `improve` (windows of r rings swept until a
 //! pass gains nothing). Imports `mesh`, `quality` and `search::optimum` only.
 
 pub mod all_quad;
 mod improve;
 mod leftovers;
 mod region;
+pub mod split_choice;
 
 pub use all_quad::Split;
+pub use split_choice::{Stuck, StuckReason};
 
 use crate::mesh::{Mesh, MeshError};
 use crate::quality::{CandidateTable, Rule};
@@ -47,8 +50,30 @@ impl Default for FinishConfig {
     }
 }
 
-/// Splits tried per leftover before all-quad gives up on it (each a rebuild of the mesh).
-const SPLIT_ATTEMPTS: usize = 8;
+/// Why a finish failed.
+#[derive(Debug, thiserror::Error)]
+pub enum FinishError {
+    /// All-quad's split made an invalid mesh (it should not: boundary sides halved).
+    #[error("all-quad split: {0}")]
+    Mesh(#[from] MeshError),
+    /// All-quad cannot leave every triangle paired: the components no boundary split fixes.
+    #[error("all-quad cannot pair every triangle: {}", join(.0))]
+    NotAllQuad(Vec<Stuck>),
+    /// The split mesh still leaves triangles although each split was checked to make its
+    /// component perfectly matchable (a bug).
+    #[error(
+        "all-quad: the split mesh still leaves {0} triangles, although each split was checked to make its component perfectly matchable (a bug)"
+    )]
+    SplitLeft(usize),
+}
+
+fn join(stuck: &[Stuck]) -> String {
+    stuck
+        .iter()
+        .map(|s| s.to_string())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
 
 /// Default first ring count of elimination.
 pub const DEFAULT_RINGS: u32 = 2;
@@ -134,13 +159,14 @@ fn figures(table: &CandidateTable, pairing: &Pairing, time_s: f64) -> StepFigure
 }
 
 /// Finishes the pairing `chosen` (candidates of `table`, a matching) of `mesh`. Errors only
-/// when all-quad's split makes an invalid mesh (it should not: a boundary side halved).
+/// with all-quad: when a component keeps triangles that no boundary split can pair
+/// ([`FinishError::NotAllQuad`], naming each), or (a bug) when a split goes wrong.
 pub fn finish(
     mesh: &Mesh,
     table: &CandidateTable,
     chosen: &[u32],
     config: FinishConfig,
-) -> Result<Finished, MeshError> {
+) -> Result<Finished, FinishError> {
     let nt = mesh.num_triangles();
     let mut stats = FinishStats::default();
     let t0 = Instant::now();
@@ -157,56 +183,31 @@ pub fn finish(
     let mut splits = Vec::new();
     if config.all_quad {
         let t1 = Instant::now();
-        let mut pairing_after = None;
-        let left: Vec<u32> = pairing.leftovers().collect();
-        let mut excluded = vec![false; nt];
-        for _ in 0..SPLIT_ATTEMPTS {
-            if left.is_empty() {
-                break;
-            }
-            let mut p = pairing.clone();
-            let Some(s) =
-                all_quad::split_leftovers(mesh, table, &mut p, &left, config.rule, &excluded)?
-            else {
-                break;
-            };
+        if pairing.leftovers().next().is_some() {
+            let chosen = split_choice::choose(
+                mesh,
+                table,
+                &pairing,
+                config.rule,
+                config.rings,
+                &mut stats.regions,
+            )
+            .map_err(FinishError::NotAllQuad)?;
+            let s = all_quad::split(mesh, table, &chosen, config.rule)?;
             let n = s.mesh.num_triangles();
             let mut p = s.pairing;
-            let (mut r, mut so) = (Rings::new(n), RegionSolver::new(n));
-            let e = leftovers::eliminate(&s.table, &mut p, &mut r, &mut so, config.rings);
+            (rings, solver) = (Rings::new(n), RegionSolver::new(n));
+            // Pairs a half whose pair the new table computed otherwise (rounding) too.
+            let e = leftovers::eliminate(&s.table, &mut p, &mut rings, &mut solver, config.rings);
             stats.regions += e.regions;
             stats.max_rings = stats.max_rings.max(e.max_rings);
-            // A split whose component still leaves a triangle did not make it perfectly
-            // matchable: try that leftover elsewhere.
-            let (component, _) = CandidateTable::components(&s.table.dual_graph());
-            let mut stuck = vec![false; n];
-            for t in p.leftovers() {
-                stuck[component[t as usize] as usize] = true;
+            let left = p.leftovers().count();
+            if left > 0 {
+                return Err(FinishError::SplitLeft(left));
             }
-            let failed: Vec<u32> = s
-                .splits
-                .iter()
-                .map(|sp| sp.triangle)
-                .filter(|&b| stuck[component[b as usize] as usize])
-                .collect();
-            let done = failed.is_empty();
-            for b in failed {
-                excluded[b as usize] = true;
-            }
-            let better = split_mesh.is_none() || done;
-            if better {
-                pairing_after = Some(p);
-                rings = r;
-                solver = so;
-                splits = s.splits;
-                split_mesh = Some((s.mesh, s.table));
-            }
-            if done {
-                break;
-            }
-        }
-        if let Some(p) = pairing_after {
             pairing = p;
+            splits = s.splits;
+            split_mesh = Some((s.mesh, s.table));
         }
         let t = split_mesh.as_ref().map_or(table, |(_, t)| t);
         all_quad = Some(figures(t, &pairing, t1.elapsed().as_secs_f64()));

@@ -104,6 +104,19 @@ impl Rings {
 
     /// Grows `rings` rings around `seeds` (ring 0 included, so `rings + 1` in all).
     pub fn grow(&mut self, table: &CandidateTable, pairing: &Pairing, seeds: &[u32], rings: u32) {
+        self.grow_where(table, pairing, seeds, rings, |_| true);
+    }
+
+    /// [`Rings::grow`] through the triangles `keep` accepts only (the others are walls; seeds
+    /// and their mates must be kept ones).
+    pub fn grow_where(
+        &mut self,
+        table: &CandidateTable,
+        pairing: &Pairing,
+        seeds: &[u32],
+        rings: u32,
+        keep: impl Fn(u32) -> bool,
+    ) {
         self.next_epoch();
         self.members.clear();
         self.ends.clear();
@@ -119,7 +132,7 @@ impl Rings {
                 for c in table.by_triangle[t as usize] {
                     if c != NONE {
                         let u = table.other(c, t);
-                        if self.stamp[u as usize] != self.epoch {
+                        if self.stamp[u as usize] != self.epoch && keep(u) {
                             self.add(table, pairing, u);
                         }
                     }
@@ -131,6 +144,20 @@ impl Rings {
             }
             start = end;
         }
+    }
+
+    /// True when no allowed pair leads from the region last grown to a triangle outside it
+    /// that `keep` accepts: the region holds whole components of the dual graph less the
+    /// triangles `keep` refuses.
+    pub fn closed(&self, table: &CandidateTable, keep: impl Fn(u32) -> bool) -> bool {
+        self.members.iter().all(|&t| {
+            table.by_triangle[t as usize].into_iter().all(|c| {
+                c == NONE || {
+                    let u = table.other(c, t);
+                    self.stamp[u as usize] == self.epoch || !keep(u)
+                }
+            })
+        })
     }
 
     /// The connected groups of the region last grown (connected through allowed pairs), each

@@ -1,6 +1,7 @@
 //! The one integration-test binary: each module tests one area through the library or the CLI.
 
 mod across;
+mod all_quad;
 mod cli_edge;
 mod files;
 mod finish;
@@ -19,6 +20,7 @@ mod runner_extend;
 mod search;
 mod search_oracle;
 mod suite;
+mod sweep_all_quad;
 mod sweep_finish;
 mod util;
 mod valid_output;
