@@ -65,7 +65,7 @@ pub struct Args {
     /// calibrated once, by pilot runs, into the knob of every method with one (the node
     /// budget of optimistic, mcts and beam at each horizon; the horizon of selective and
     /// uniform), and recorded; the runs then replay from their seeds (docs/search.md).
-    #[arg(long, value_name = "T", num_args = 1.., value_delimiter = ',', value_parser = parse_time_budget)]
+    #[arg(long, value_name = "T", num_args = 1.., value_delimiter = ',', value_parser = parse_time_budget, allow_negative_numbers = true)]
     time_budgets: Vec<TimeBudget>,
     /// Runs per (mesh, randomized method, horizon, budget): selective, optimistic, mcts,
     /// beam [default: 128; with --suite, 32].

@@ -511,6 +511,82 @@ pub fn calibrate_spec(
     Ok(out)
 }
 
+/// The calibration of one run (`recombine --time-budget`): the knob of `algo` (its node
+/// budget at `horizon`, or its horizon) for `t`, found by pilot runs one after another on
+/// this thread (as the run itself goes), with seeds derived from `seed` and a calibration
+/// tag, never `seed` itself. Returns the choice and the probes.
+pub fn calibrate_run(
+    mesh: &crate::mesh::Mesh,
+    table: &crate::quality::CandidateTable,
+    algo: &str,
+    horizon: Option<u32>,
+    t: TimeBudget,
+    seed: u64,
+) -> Result<(Choice, Vec<Probe>), crate::search::AlgoError> {
+    let nodes = has_budget(algo);
+    let (kind, range) = if nodes {
+        let b = crate::search::methods::BUDGET;
+        (KnobKind::Nodes, (b.min, b.max))
+    } else {
+        (KnobKind::Horizon, (1, MAX_HORIZON))
+    };
+    // Checks the method and the given horizon once, before any pilot.
+    crate::search::Algo::new(
+        algo,
+        crate::search::Params {
+            horizon,
+            budget: None,
+        },
+    )?;
+    let mut searcher = crate::search::Searcher::new(mesh, table);
+    let mut measure = |knob: u32| -> Result<(Vec<f64>, u64), crate::search::AlgoError> {
+        let params = if nodes {
+            crate::search::Params {
+                horizon,
+                budget: Some(knob),
+            }
+        } else {
+            crate::search::Params {
+                horizon: Some(knob),
+                budget: None,
+            }
+        };
+        let method = crate::search::Algo::new(algo, params)?;
+        let mut times = Vec::new();
+        let mut digest = blake3::Hasher::new();
+        for i in 0..MIN_PILOTS {
+            let pilot = super::seed::derive_seed(
+                super::seed::PLAN_VERSION,
+                seed,
+                "recombine",
+                &format!("calibration {algo}"),
+                horizon,
+                i,
+            );
+            let out = searcher.run(method, pilot);
+            times.push(out.time_s);
+            digest.update(&(out.quads as u64).to_le_bytes());
+            digest.update(&out.quality.to_bits().to_le_bytes());
+        }
+        let digest = u64::from_le_bytes(
+            digest.finalize().as_bytes()[..8]
+                .try_into()
+                .expect("8 bytes"),
+        );
+        Ok((times, digest))
+    };
+    let mut probes = Vec::new();
+    let choice = search_knobs(
+        &[t.seconds()],
+        kind,
+        range,
+        TOLERANCE,
+        &mut probes,
+        &mut measure,
+    )?;
+    Ok((choice[0], probes))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
