@@ -253,10 +253,16 @@ pub fn search_knobs<E>(
     let mut sorted: Vec<f64> = targets.to_vec();
     sorted.sort_by(f64::total_cmp);
     let mut digests: Vec<(u32, u64)> = Vec::new();
-    // The smallest knob whose results a larger knob repeats.
+    // The smallest knob whose pilot results every larger knob probed repeats, one of them
+    // at least twice as large: the budget no longer binds there (equal results at two
+    // nearby knobs, or with a different result above, prove nothing).
     let ceiling = |digests: &[(u32, u64)]| {
         (digests.iter())
-            .filter(|(k, d)| digests.iter().any(|(k2, d2)| k2 > k && d2 == d))
+            .filter(|(k, d)| {
+                let above: Vec<&(u32, u64)> = digests.iter().filter(|(k2, _)| k2 > k).collect();
+                above.iter().any(|(k2, _)| u64::from(*k2) >= 2 * u64::from(*k))
+                    && above.iter().all(|(_, d2)| d2 == d)
+            })
             .map(|(k, _)| *k)
             .min()
             .unwrap_or(max)
@@ -353,7 +359,7 @@ fn choose(probes: &[Probe], limit: f64, top: u32) -> Choice {
         knob: p.knob,
         median_s: p.median_s(),
         fits: fit.is_some(),
-        saturated: p.knob == top && probes.iter().any(|q| q.knob > top),
+        saturated: fit.is_some() && p.knob == top && probes.iter().any(|q| q.knob > top),
     }
 }
 
@@ -721,6 +727,28 @@ mod tests {
         assert!(c[0].fits && c[0].saturated, "{c:?}");
         assert!(c[0].knob >= 40 && c[0].knob < 1000, "{c:?} {probes:?}");
         assert!(probes.len() <= 4, "{probes:?}");
+    }
+
+    #[test]
+    fn equal_results_at_two_knobs_with_another_above_are_no_saturation() {
+        // Knobs 1 and 3 make the same pilot runs, 16 others (the budget binds): the knob
+        // chosen for a budget that 8 fits is not held at 1.
+        let mut measure = |k: u32| {
+            let digest = if k <= 3 { 0 } else { u64::from(k) };
+            Ok::<_, ()>((vec![0.1 + 0.01 * f64::from(k); 3], digest))
+        };
+        let mut probes = Vec::new();
+        let c = search_knobs(
+            &[0.05, 0.18],
+            KnobKind::Nodes,
+            (1, 1 << 24),
+            TOLERANCE,
+            &mut probes,
+            &mut measure,
+        )
+        .unwrap();
+        assert_eq!((c[0].knob, c[0].fits, c[0].saturated), (1, false, false));
+        assert!(c[1].fits && !c[1].saturated && c[1].knob >= 6, "{c:?} {probes:?}");
     }
 
     #[test]
