@@ -260,7 +260,9 @@ pub fn search_knobs<E>(
         (digests.iter())
             .filter(|(k, d)| {
                 let above: Vec<&(u32, u64)> = digests.iter().filter(|(k2, _)| k2 > k).collect();
-                above.iter().any(|(k2, _)| u64::from(*k2) >= 2 * u64::from(*k))
+                above
+                    .iter()
+                    .any(|(k2, _)| u64::from(*k2) >= 2 * u64::from(*k))
                     && above.iter().all(|(_, d2)| d2 == d)
             })
             .map(|(k, _)| *k)
@@ -748,7 +750,10 @@ mod tests {
         )
         .unwrap();
         assert_eq!((c[0].knob, c[0].fits, c[0].saturated), (1, false, false));
-        assert!(c[1].fits && !c[1].saturated && c[1].knob >= 6, "{c:?} {probes:?}");
+        assert!(
+            c[1].fits && !c[1].saturated && c[1].knob >= 6,
+            "{c:?} {probes:?}"
+        );
     }
 
     #[test]

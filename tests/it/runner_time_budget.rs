@@ -109,6 +109,40 @@ fn a_time_budget_sweep_calibrates_records_reports_and_replays() {
     assert!(report.contains("By time budget"), "{report}");
     assert!(report.contains("time-budget.svg"));
     assert!(report.contains("Policies against selective at the same time budget"));
+    // An extension with one more time budget keeps the calibrations and makes only the new
+    // ones (selective and mcts h=2 at 10 ms); the recorded runs stay.
+    let before = std::fs::read(dir.path().join("t/runs.jsonl")).unwrap();
+    let mut wider: Vec<&str> = args.iter().map(String::as_str).collect();
+    wider.extend([
+        "--algo",
+        "selective",
+        "mcts",
+        "greedy",
+        "--time-budgets",
+        "2ms,0.02,10ms",
+        "--threads",
+        "2",
+        "--extend",
+        "--no-report",
+    ]);
+    let ext = run_in(dir.path(), &wider);
+    assert!(ext.status.success(), "extend: {}", stderr(&ext));
+    assert_eq!(
+        stderr(&ext).matches("sweep: calibrated ").count(),
+        2,
+        "{}",
+        stderr(&ext)
+    );
+    let m2 = Manifest::read(&dir.path().join("t")).unwrap();
+    assert_eq!(
+        m2.spec.calibration[..4],
+        m.spec.calibration[..],
+        "kept as they were"
+    );
+    assert_eq!(m2.spec.calibration.len(), 6);
+    let after = std::fs::read(dir.path().join("t/runs.jsonl")).unwrap();
+    assert!(after.starts_with(&before));
+    assert_eq!(records(&dir.path().join("t")).len(), recs.len() + 2 * 3);
     // Every time-budgeted record replays from its seed.
     for r in recs.iter().filter(|r| r.time_budget_s.is_some()) {
         let mut a = vec![
