@@ -204,7 +204,7 @@ fn figure(mesh: &str, name: &str, rows: &[Row<'_>]) -> Result<String, ReportErro
         for (i, line) in lines.iter().enumerate() {
             let color = colors[i % colors.len()];
             let mut mine: Vec<&Row<'_>> = rows.iter().filter(|r| line_of(r) == *line).collect();
-            mine.sort_by(|a, b| a.t.cmp(&b.t));
+            mine.sort_by_key(|r| r.t);
             chart
                 .draw_series(LineSeries::new(
                     mine.iter().map(|r| (r.t.seconds(), r.q[1])),
