@@ -158,7 +158,7 @@ fn node_budgets(
 }
 
 /// Colours of the lines, by method (in order of appearance).
-pub(super) const COLORS: [RGBColor; 6] = [
+const COLORS: [RGBColor; 6] = [
     RGBColor(220, 20, 20),
     RGBColor(20, 60, 170),
     RGBColor(20, 140, 60),

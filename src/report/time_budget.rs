@@ -160,6 +160,19 @@ pub(super) fn time_budgets(
     Ok(())
 }
 
+/// Colours of the lines (methods, and horizons of the budgeted ones), in order: one more
+/// line than the node-budget figure has (selective and three policies at two horizons).
+const COLORS: [RGBColor; 8] = [
+    RGBColor(220, 20, 20),
+    RGBColor(20, 60, 170),
+    RGBColor(20, 140, 60),
+    RGBColor(150, 60, 170),
+    RGBColor(230, 130, 0),
+    RGBColor(90, 90, 90),
+    RGBColor(0, 170, 190),
+    RGBColor(170, 110, 40),
+];
+
 /// The figure: quality against the time budget, one line per method (and horizon, for the
 /// budgeted methods), IQR bars.
 fn figure(mesh: &str, name: &str, rows: &[Row<'_>]) -> Result<String, ReportError> {
@@ -200,9 +213,8 @@ fn figure(mesh: &str, name: &str, rows: &[Row<'_>]) -> Result<String, ReportErro
             .y_desc(name)
             .draw()
             .map_err(plot_err)?;
-        let colors = super::budget::COLORS;
         for (i, line) in lines.iter().enumerate() {
-            let color = colors[i % colors.len()];
+            let color = COLORS[i % COLORS.len()];
             let mut mine: Vec<&Row<'_>> = rows.iter().filter(|r| line_of(r) == *line).collect();
             mine.sort_by_key(|r| r.t);
             chart
