@@ -1,6 +1,7 @@
 //! `quadrecomb recombine`: one run of one policy on one mesh.
 
 use super::UsageError;
+use quadrecomb::internals::experiment::calibrate::{self, TimeBudget};
 use quadrecomb::internals::experiment::replay::{self, EtaSource};
 use quadrecomb::internals::quality::{self, CandidateTable, ElementQuality, Rule};
 use quadrecomb::internals::search::{self, Algo, optimum};
@@ -44,6 +45,12 @@ pub struct Args {
     /// others have none).
     #[arg(long)]
     budget: Option<u32>,
+    /// A wall-time budget for the run, in seconds (0.2, 2s) or milliseconds (50ms): the
+    /// node budget (optimistic, mcts, beam) or the horizon (selective, uniform) is first
+    /// calibrated by pilot runs on other seeds to the largest whose median time fits, said
+    /// on stderr; give that knob to repeat the run (docs/search.md).
+    #[arg(long, value_name = "T", value_parser = parse_time_budget, allow_negative_numbers = true)]
+    time_budget: Option<TimeBudget>,
     /// Seed of the run (ChaCha8: the same seed gives the same run everywhere).
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -115,9 +122,59 @@ pub fn eta_table(
     Ok(replay::eta_table(mesh, source, rule)?)
 }
 
+/// A `--time-budget` value.
+fn parse_time_budget(s: &str) -> Result<TimeBudget, String> {
+    s.parse::<TimeBudget>()
+        .map_err(|e| format!("bad time budget: {e}"))
+}
+
 /// The horizon of a tree policy; `None` for the greedy ones.
 fn horizon_of(algo: Algo) -> Option<u32> {
     algo.params().horizon
+}
+
+/// `algo` with its knob calibrated to `t` by pilot runs (on stderr: what was chosen).
+fn calibrated(
+    mesh: &quadrecomb::internals::mesh::Mesh,
+    table: &CandidateTable,
+    algo: Algo,
+    t: TimeBudget,
+    seed: u64,
+) -> anyhow::Result<Algo> {
+    let name = algo.name();
+    let nodes = algo.budget().is_some();
+    let horizon = if nodes { algo.params().horizon } else { None };
+    let (choice, probes) = calibrate::calibrate_run(mesh, table, name, horizon, t, seed)
+        .map_err(|e| UsageError(e.to_string()))?;
+    let params = if nodes {
+        search::Params {
+            horizon,
+            budget: Some(choice.knob),
+        }
+    } else {
+        search::Params {
+            horizon: Some(choice.knob),
+            budget: None,
+        }
+    };
+    let flag = if nodes { "--budget" } else { "--horizon" };
+    eprintln!(
+        "recombine: --time-budget {t} calibrated to {flag} {} (median {:.3} s over {} pilot runs \
+         on other seeds; {} values tried){}; to repeat this run give {flag} {} instead",
+        choice.knob,
+        choice.median_s,
+        calibrate::MIN_PILOTS,
+        probes.len(),
+        if choice.saturated {
+            ": it covers the pilots' trees, a larger one makes the same runs"
+        } else if !choice.fits {
+            ": over the budget even at the smallest value"
+        } else {
+            ""
+        },
+        choice.knob
+    );
+    Ok(Algo::new(name, params).map_err(|e| UsageError(e.to_string()))?)
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -126,7 +183,30 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         horizon: args.horizon,
         budget: args.budget,
     };
-    let algo = Algo::new(name, given).map_err(|e| match e {
+    if let Some(t) = args.time_budget {
+        if !calibrate::has_knob(name) {
+            return Err(UsageError(format!(
+                "--time-budget {t}: {name} has no horizon or node budget to calibrate (give \
+                 selective, uniform, optimistic, mcts or beam)"
+            ))
+            .into());
+        }
+        let knob = if search::methods::find(name)
+            .is_some_and(|m| m.has(search::methods::ParamKind::Budget))
+        {
+            args.budget.map(|_| "--budget")
+        } else {
+            args.horizon.map(|_| "--horizon")
+        };
+        if let Some(flag) = knob {
+            return Err(UsageError(format!(
+                "--time-budget {t} and {flag}: the time budget chooses {flag} for {name}; give \
+                 one of them"
+            ))
+            .into());
+        }
+    }
+    let mut algo = Algo::new(name, given).map_err(|e| match e {
         // Name the flag that carried the value.
         search::methods::AlgoError::OutOfRange { param, .. } => {
             UsageError(format!("--{param}: {e}"))
@@ -152,6 +232,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     oom::mesh_size(mesh.num_triangles());
     oom::phase(Phase::Candidates);
     let (table, backend) = eta_table(&mesh, args.backend, rule)?;
+    if let Some(t) = args.time_budget {
+        algo = calibrated(&mesh, &table, algo, t, args.seed)?;
+    }
     oom::phase(Phase::Search);
     let mut searcher = search::Searcher::new(&mesh, &table);
     let bar = super::progress_bar::attach(&mut searcher, horizon_of(algo));

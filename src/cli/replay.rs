@@ -31,11 +31,22 @@ pub struct Args {
     /// smallest recorded).
     #[arg(long)]
     budget: Option<u32>,
+    /// Time budget of the configuration, for those of `sweep --time-budgets` (seconds, as
+    /// recorded in `time_budget_s`; default: a configuration without one first).
+    #[arg(long, value_name = "T", value_parser = parse_time_budget)]
+    time_budget: Option<quadrecomb::internals::experiment::calibrate::TimeBudget>,
     #[command(flatten)]
     out: super::MeshOutputArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
+}
+
+/// A `--time-budget` value.
+fn parse_time_budget(
+    s: &str,
+) -> Result<quadrecomb::internals::experiment::calibrate::TimeBudget, String> {
+    s.parse().map_err(|e| format!("bad time budget: {e}"))
 }
 
 /// Which run: an index or the typical one.
@@ -65,6 +76,7 @@ fn choose_config<'r>(
             && args.algo.as_ref().is_none_or(|a| *a == c.algo)
             && args.horizon.is_none_or(|h| Some(h) == c.horizon)
             && args.budget.is_none_or(|b| Some(b) == c.budget)
+            && args.time_budget.is_none_or(|t| Some(t) == c.time_budget)
     });
     if let Some((c, runs)) = found {
         return Ok((c, runs));
@@ -74,6 +86,7 @@ fn choose_config<'r>(
     asked.extend(args.algo.as_ref().map(|a| format!("algorithm {a}")));
     asked.extend(args.horizon.map(|h| format!("horizon {h}")));
     asked.extend(args.budget.map(|b| format!("budget {b}")));
+    asked.extend(args.time_budget.map(|t| format!("time budget {t}")));
     let held: Vec<String> = (results.groups.keys())
         .map(|c| format!("{} {}", c.mesh, c.label()))
         .collect();

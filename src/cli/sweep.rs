@@ -5,6 +5,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context;
+use quadrecomb::internals::experiment::calibrate::TimeBudget;
 use quadrecomb::internals::experiment::config::{
     ConfigError, DEFAULT_SEED, MAX_HORIZONS, MAX_RUNS, SizeError, SweepConfig, SweepRequest,
 };
@@ -57,9 +58,15 @@ pub struct Args {
     #[arg(long, value_name = "H", value_parser = parse_horizons)]
     horizons: Option<Horizons>,
     /// Node budgets per decision of optimistic, mcts and beam (one configuration each, per
-    /// horizon): a list 16,64,256 or several values.
-    #[arg(long, value_name = "B", num_args = 1.., value_delimiter = ',', default_value = "64")]
+    /// horizon): a list 16,64,256 or several values [default: 64; none with --time-budgets].
+    #[arg(long, value_name = "B", num_args = 1.., value_delimiter = ',')]
     budgets: Vec<u32>,
+    /// Wall-time budgets per run, in seconds (0.2, 2s) or milliseconds (50ms): each is
+    /// calibrated once, by pilot runs, into the knob of every method with one (the node
+    /// budget of optimistic, mcts and beam at each horizon; the horizon of selective and
+    /// uniform), and recorded; the runs then replay from their seeds (docs/search.md).
+    #[arg(long, value_name = "T", num_args = 1.., value_delimiter = ',', value_parser = parse_time_budget, allow_negative_numbers = true)]
+    time_budgets: Vec<TimeBudget>,
     /// Runs per (mesh, randomized method, horizon, budget): selective, optimistic, mcts,
     /// beam [default: 128; with --suite, 32].
     #[arg(long)]
@@ -198,6 +205,12 @@ fn parse_horizons(s: &str) -> Result<Horizons, String> {
     Ok(Horizons(list))
 }
 
+/// A `--time-budgets` value, with the flag in its error.
+fn parse_time_budget(s: &str) -> Result<TimeBudget, String> {
+    s.parse::<TimeBudget>()
+        .map_err(|e| format!("bad time budget: {e}"))
+}
+
 /// Set by Ctrl-C: the sweep stops handing out runs.
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
@@ -242,7 +255,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.algos
         },
         horizons: args.horizons.map_or(paper.horizons.clone(), |h| h.0),
-        budgets: args.budgets,
+        budgets: if args.budgets.is_empty() && args.time_budgets.is_empty() {
+            paper.budgets.clone()
+        } else {
+            args.budgets
+        },
+        time_budgets: args.time_budgets,
         runs: args.runs.unwrap_or(paper.runs),
         baseline_runs: args.baseline_runs,
         seed: args.seed,
@@ -486,6 +504,15 @@ fn config_error(e: ConfigError) -> UsageError {
         ),
         ConfigError::ZeroThreads => "--threads must be at least 1".into(),
         ConfigError::NoBudget => "--budgets: give at least one budget".into(),
+        ConfigError::DuplicateTimeBudget(t) => format!("--time-budgets: {t} given twice"),
+        ConfigError::TimeBudgetUnused(algos) => format!(
+            "--time-budgets: none of the methods ({algos}) has a horizon or node budget to \
+             calibrate (give selective, uniform, optimistic, mcts or beam)"
+        ),
+        ConfigError::TimeBudgetSharded => "--time-budgets cannot be used with --shard: each \
+             shard would calibrate its own knobs and the shards would not merge; run the sweep \
+             whole"
+            .into(),
         ConfigError::BadBudget(b) => {
             format!("--budgets {b}: each budget must be in 1..=16777216 and given once")
         }

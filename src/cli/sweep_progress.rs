@@ -57,6 +57,11 @@ impl SweepDisplay {
                     eprintln!("quality backend: {note}");
                 }
             }
+            Event::Calibrated(note) => {
+                if self.mode != ProgressMode::Quiet {
+                    eprintln!("{}", calibrated_line(note));
+                }
+            }
             Event::Extending { before, after } => {
                 if self.mode != ProgressMode::Quiet {
                     eprintln!(
@@ -225,6 +230,37 @@ fn line(s: &Shared) -> String {
     format!(
         "sweep: {done}/{} runs ({pct:.1}%), {elapsed:.1} s elapsed, ETA {eta}",
         s.total
+    )
+}
+
+/// "sweep: calibrated 2/12: borouchaki mcts h=3 at 0.2 s: budget 40 (pilot median 0.19 s
+/// over 4 pilots; 6 knobs probed)".
+pub fn calibrated_line(
+    note: &quadrecomb::internals::experiment::calibrate::CalibrationNote,
+) -> String {
+    let c = &note.calibrated;
+    let (what, given) = match c.budget {
+        Some(b) => (format!("budget {b}"), format!(" h={}", c.horizon)),
+        None => (format!("horizon {}", c.horizon), String::new()),
+    };
+    format!(
+        "sweep: calibrated {}/{}: {} {}{given} at {}: {what} (pilot median {:.3} s over {} \
+         pilots; {} knobs probed){}",
+        note.done,
+        note.total,
+        c.mesh,
+        c.algo,
+        c.time_budget_s,
+        c.median_s,
+        c.pilots,
+        c.probes.len(),
+        if c.saturated {
+            " — it covers the pilots' trees: a larger one makes the same runs".to_string()
+        } else if c.fits {
+            String::new()
+        } else {
+            " — over the budget even at the smallest knob".to_string()
+        }
     )
 }
 

@@ -38,6 +38,10 @@ pub struct SweepRequest {
     /// Node budgets per decision of the methods with one (optimistic, mcts, beam): each in
     /// the registry's range and given once; at least one when such a method is asked for.
     pub budgets: Vec<u32>,
+    /// Wall-time budgets per run, each calibrated once into the knob of every method with
+    /// one (see [`super::calibrate`]): given once each; not with a shard (every shard would
+    /// calibrate on its own).
+    pub time_budgets: Vec<super::calibrate::TimeBudget>,
     /// Runs per (mesh, tree algorithm, horizon): at least 1 when a tree algorithm is asked
     /// for, and the whole sweep at most [`MAX_RUNS`] runs.
     pub runs: u32,
@@ -77,6 +81,7 @@ impl Default for SweepRequest {
             algos: DEFAULT_ALGOS.iter().map(|s| s.to_string()).collect(),
             horizons: (1..=10).collect(),
             budgets: vec![crate::search::methods::BUDGET.default],
+            time_budgets: Vec::new(),
             runs: 128,
             baseline_runs: 1,
             seed: DEFAULT_SEED,
@@ -132,6 +137,21 @@ pub enum ConfigError {
     /// A budget is out of range or given twice.
     #[error("budget {0} is out of range (1..=16777216) or given twice")]
     BadBudget(u32),
+    /// A time budget given twice.
+    #[error("time budget {0} given twice")]
+    DuplicateTimeBudget(super::calibrate::TimeBudget),
+    /// Time budgets given, but none of the methods has a knob to calibrate.
+    #[error(
+        "time budgets given, but none of the methods has a horizon or node budget to \
+         calibrate ({0})"
+    )]
+    TimeBudgetUnused(String),
+    /// Time budgets with a shard: each shard would calibrate on its own machine.
+    #[error(
+        "time budgets cannot be sharded: each shard would calibrate its own knobs, and the \
+         shards would not merge (run the sweep whole)"
+    )]
+    TimeBudgetSharded,
     /// A base seed above 2^53 - 1, which JSON readers that hold numbers as doubles (jq,
     /// pandas with pyarrow) would read as another seed.
     #[error(
@@ -175,13 +195,22 @@ pub fn check_size(
     algos: &[String],
     horizons: usize,
     budgets: usize,
+    time_budgets: usize,
     runs: u32,
     baseline_runs: u32,
 ) -> Result<(), SizeError> {
     if horizons > MAX_HORIZONS {
         return Err(SizeError::Horizons(horizons));
     }
-    let total = planned_runs(meshes, algos, horizons, budgets, runs, baseline_runs);
+    let total = planned_runs(
+        meshes,
+        algos,
+        horizons,
+        budgets,
+        time_budgets,
+        runs,
+        baseline_runs,
+    );
     if total > MAX_RUNS {
         return Err(SizeError::Runs {
             total,
@@ -246,8 +275,21 @@ impl SweepConfig {
                 return Err(ConfigError::DuplicateHorizon(*h));
             }
         }
+        for (i, t) in r.time_budgets.iter().enumerate() {
+            if r.time_budgets[..i].contains(t) {
+                return Err(ConfigError::DuplicateTimeBudget(*t));
+            }
+        }
+        if !r.time_budgets.is_empty() {
+            if !r.algos.iter().any(|a| super::calibrate::has_knob(a)) {
+                return Err(ConfigError::TimeBudgetUnused(r.algos.join(", ")));
+            }
+            if r.shard.is_some() {
+                return Err(ConfigError::TimeBudgetSharded);
+            }
+        }
         if r.algos.iter().any(|a| has_budget(a)) {
-            if r.budgets.is_empty() {
+            if r.budgets.is_empty() && r.time_budgets.is_empty() {
                 return Err(ConfigError::NoBudget);
             }
             let range = crate::search::methods::BUDGET;
@@ -265,6 +307,7 @@ impl SweepConfig {
             &r.algos,
             r.horizons.len(),
             r.budgets.len(),
+            r.time_budgets.len(),
             r.runs,
             r.baseline_runs,
         )?;
@@ -289,6 +332,11 @@ impl SweepConfig {
     /// Horizons of `uniform` and `selective`.
     pub fn horizons(&self) -> &[u32] {
         &self.0.horizons
+    }
+
+    /// Wall-time budgets per run, to calibrate.
+    pub fn time_budgets(&self) -> &[super::calibrate::TimeBudget] {
+        &self.0.time_budgets
     }
 
     /// Runs per (mesh, tree algorithm, horizon).
@@ -363,6 +411,12 @@ impl SweepConfig {
             } else {
                 Vec::new()
             },
+            time_budgets: if c.algos.iter().any(|a| super::calibrate::has_knob(a)) {
+                c.time_budgets.clone()
+            } else {
+                Vec::new()
+            },
+            calibration: Vec::new(),
             runs: c.runs,
             baseline_runs: c.baseline_runs,
             seed: c.seed,

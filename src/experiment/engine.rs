@@ -82,6 +82,7 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
         algo: job.algo.clone(),
         horizon: job.horizon,
         budget: job.budget,
+        time_budget_s: job.time_budget,
         seed: job.seed,
         run: job.run,
         quads: out.quads,

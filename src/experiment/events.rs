@@ -8,6 +8,8 @@ use crate::gpu::BackendNote;
 pub enum Event<'a> {
     /// How the quality backend was chosen (with [`crate::gpu::Backend::Auto`]).
     Backend(&'a BackendNote),
+    /// A time budget was calibrated (before any run: `sweep --time-budgets`).
+    Calibrated(&'a super::calibrate::CalibrationNote),
     /// A sweep extends its directory's configuration: its run list grows.
     Extending {
         /// Runs in the directory's run list before.

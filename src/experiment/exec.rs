@@ -211,6 +211,7 @@ pub(crate) mod tests {
                 algo: "selective".into(),
                 horizon: Some(1 + run % 3),
                 budget: None,
+                time_budget: None,
                 run,
                 seed: u64::from(run) * 7919,
             })

@@ -74,6 +74,15 @@ pub struct SweepSpec {
     /// --finish`); absent without.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub finish: Option<super::finished::FinishSettings>,
+    /// Wall-time budgets per run (`sweep --time-budgets`), each calibrated into the knob of
+    /// every method with one ([`super::calibrate`]); absent without.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub time_budgets: Vec<super::calibrate::TimeBudget>,
+    /// The calibrations of the time budgets: the knob each (mesh, method, horizon, time
+    /// budget) runs with, how it was found, on what machine. Made once; a resumed or
+    /// extended sweep reuses them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub calibration: Vec<super::calibrate::Calibrated>,
 }
 
 /// The plan version of manifests written before the field existed.
@@ -250,10 +259,16 @@ impl Manifest {
             &s.algos,
             s.horizons.len(),
             s.budgets.len(),
+            s.time_budgets.len(),
             s.runs,
             s.baseline_runs,
         );
-        let why = if let Err(e) = size {
+        let bad_time = (s.time_budgets.iter())
+            .chain(s.calibration.iter().map(|c| &c.time_budget_s))
+            .find(|t| !t.is_valid());
+        let why = if let Some(t) = bad_time {
+            Some(format!("time budget {} s is out of range", t.seconds()))
+        } else if let Err(e) = size {
             Some(match e {
                 SizeError::Runs { total, .. } => format!(
                     "its spec makes {total} runs, more than a sweep takes ({})",
@@ -406,6 +421,21 @@ pub fn union_spec(a: &SweepSpec, b: &SweepSpec) -> SweepSpec {
             u.budgets.push(*x);
         }
     }
+    for t in &b.time_budgets {
+        if !u.time_budgets.contains(t) {
+            u.time_budgets.push(*t);
+        }
+    }
+    for c in &b.calibration {
+        let given = super::plan::has_budget(&c.algo).then_some(c.horizon);
+        if !u
+            .calibration
+            .iter()
+            .any(|d| d.is_for(&c.mesh, &c.algo, given, c.time_budget_s))
+        {
+            u.calibration.push(c.clone());
+        }
+    }
     u.runs = match (uses_runs(a), uses_runs(b)) {
         (true, true) => a.runs.max(b.runs),
         (false, true) => b.runs,
@@ -439,6 +469,26 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
     }
     if a.budgets != b.budgets {
         return Some(format!("budgets {:?} vs {:?}", a.budgets, b.budgets));
+    }
+    if a.time_budgets != b.time_budgets {
+        let say = |v: &[super::calibrate::TimeBudget]| {
+            v.iter()
+                .map(|t| t.seconds().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        return Some(format!(
+            "time budgets [{}] vs [{}]",
+            say(&a.time_budgets),
+            say(&b.time_budgets)
+        ));
+    }
+    if a.calibration != b.calibration {
+        return Some(
+            "the calibrations of the time budgets differ (another calibration: resume with the \
+             directory's own manifest)"
+                .into(),
+        );
     }
     if a.runs != b.runs {
         return Some(format!("runs {} vs {}", a.runs, b.runs));

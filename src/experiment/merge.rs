@@ -106,6 +106,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
         &spec.algos,
         spec.horizons.len(),
         spec.budgets.len(),
+        spec.time_budgets.len(),
         spec.runs,
         spec.baseline_runs,
     )

@@ -6,6 +6,7 @@
 //! flushed line of `runs.jsonl` ([`store`]), and the directory can be resumed after a kill,
 //! split into shards and merged back ([`merge`]). [`summary`] turns records into statistics.
 
+pub mod calibrate;
 pub mod config;
 pub mod engine;
 pub mod events;

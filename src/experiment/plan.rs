@@ -1,5 +1,6 @@
 //! The run list of a sweep, its sharding, and the order runs execute in.
 
+use super::calibrate::{TimeBudget, has_knob};
 use super::manifest::{Shard, SweepSpec};
 use super::record::RunKey;
 use super::seed::derive_seed;
@@ -63,6 +64,8 @@ pub struct Job {
     pub horizon: Option<u32>,
     /// Nodes per decision, for the methods with a budget.
     pub budget: Option<u32>,
+    /// The wall-time budget the horizon or node budget was calibrated for (`--time-budgets`).
+    pub time_budget: Option<TimeBudget>,
     /// Run index within the configuration.
     pub run: u32,
     /// The derived seed.
@@ -77,6 +80,7 @@ impl Job {
             algo: self.algo.clone(),
             horizon: self.horizon,
             budget: self.budget,
+            time_budget_s: self.time_budget,
             run: self.run,
         }
     }
@@ -89,6 +93,7 @@ pub fn planned_runs(
     algos: &[String],
     horizons: usize,
     budgets: usize,
+    time_budgets: usize,
     runs: u32,
     baseline_runs: u32,
 ) -> u64 {
@@ -96,12 +101,22 @@ pub fn planned_runs(
     let per_mesh = algos
         .iter()
         .map(|a| {
-            let mut n = u64::from(runs_of(a, version, runs, baseline_runs));
+            let one = u64::from(runs_of(a, version, runs, baseline_runs));
+            let mut n = one;
             if has_horizon(a) {
                 n = (horizons as u64).saturating_mul(n);
             }
             if has_budget(a) {
                 n = (budgets as u64).saturating_mul(n);
+            }
+            // A time budget is one more configuration per horizon of a budgeted method, and
+            // one per mesh of selective and uniform (their horizon is the knob).
+            if has_knob(a) {
+                let per = if has_budget(a) { horizons as u64 } else { 1 };
+                let timed = (time_budgets as u64)
+                    .saturating_mul(per)
+                    .saturating_mul(one);
+                n = n.saturating_add(timed);
             }
             n
         })
@@ -142,6 +157,7 @@ pub fn plan(spec: &SweepSpec) -> Vec<Job> {
                             algo: algo.clone(),
                             horizon,
                             budget,
+                            time_budget: None,
                             run,
                             seed: derive_seed(
                                 spec.plan_version,
@@ -155,9 +171,51 @@ pub fn plan(spec: &SweepSpec) -> Vec<Job> {
                     }
                 }
             }
+            if has_knob(algo) {
+                timed_jobs(spec, m, algo, runs, &mut jobs);
+            }
         }
     }
     jobs
+}
+
+/// The runs of `algo` on mesh `m` at each of the spec's time budgets, with the knob its
+/// calibration chose (a time budget not calibrated yet has no runs). A time budget enters the
+/// seed as part of the name ("mcts t=0.2"), not the knob chosen: the runs of a time budget
+/// have the same seeds on any machine.
+fn timed_jobs(spec: &SweepSpec, m: usize, algo: &str, runs: u32, jobs: &mut Vec<Job>) {
+    let mesh = &spec.meshes[m];
+    let horizons: Vec<Option<u32>> = if has_budget(algo) {
+        spec.horizons.iter().map(|&h| Some(h)).collect()
+    } else {
+        vec![None]
+    };
+    for given in horizons {
+        for &t in &spec.time_budgets {
+            let Some(c) = super::calibrate::find(spec, &mesh.name, algo, given, t) else {
+                continue;
+            };
+            let named = format!("{algo} t={}", t.seconds());
+            for run in 0..runs {
+                jobs.push(Job {
+                    mesh: m,
+                    algo: algo.to_string(),
+                    horizon: Some(c.horizon),
+                    budget: c.budget,
+                    time_budget: Some(t),
+                    run,
+                    seed: derive_seed(
+                        spec.plan_version,
+                        spec.seed,
+                        &mesh.hash,
+                        &named,
+                        Some(c.horizon),
+                        run,
+                    ),
+                });
+            }
+        }
+    }
 }
 
 /// The jobs of one shard: job number k (0-based, canonical order) belongs to shard
@@ -227,6 +285,8 @@ pub(crate) mod tests {
             allow_invalid: false,
             plan_version: crate::experiment::seed::PLAN_VERSION,
             budgets: Vec::new(),
+            time_budgets: Vec::new(),
+            calibration: Vec::new(),
         }
     }
 
@@ -239,7 +299,7 @@ pub(crate) mod tests {
         assert_eq!(count(&s, "uniform"), 2 * 3 * 2);
         assert_eq!(count(&s, "selective"), 2 * 3 * 5);
         assert_eq!(
-            planned_runs(2, &s.algos, 3, 0, s.runs, s.baseline_runs),
+            planned_runs(2, &s.algos, 3, 0, 0, s.runs, s.baseline_runs),
             plan(&s).len() as u64
         );
         // Version 1 (older manifests) keeps its run list, so those sweeps still resume.

@@ -30,6 +30,10 @@ pub struct RunRecord {
     /// absent for the others.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub budget: Option<u32>,
+    /// The wall-time budget per run (seconds) that `horizon` or `budget` was calibrated for
+    /// (`sweep --time-budgets`, see [`super::calibrate`]); absent for the others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_budget_s: Option<super::calibrate::TimeBudget>,
     /// The per-run seed given to the search, derived by [`super::seed::derive_seed`].
     pub seed: u64,
     /// Index of the run within its (mesh, algo, horizon) configuration, from 0.
@@ -140,6 +144,9 @@ pub struct RunKey {
     /// Budget, for the budgeted policies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub budget: Option<u32>,
+    /// Time budget, for the configurations calibrated to one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_budget_s: Option<super::calibrate::TimeBudget>,
     /// Run index.
     pub run: u32,
 }
@@ -153,6 +160,9 @@ impl std::fmt::Display for RunKey {
         if let Some(b) = self.budget {
             write!(f, " b={b}")?;
         }
+        if let Some(t) = self.time_budget_s {
+            write!(f, " T={}s", t.seconds())?;
+        }
         write!(f, " run {}", self.run)
     }
 }
@@ -165,6 +175,7 @@ impl RunRecord {
             algo: self.algo.clone(),
             horizon: self.horizon,
             budget: self.budget,
+            time_budget_s: self.time_budget_s,
             run: self.run,
         }
     }

@@ -138,6 +138,7 @@ pub(crate) mod tests {
             algo: "selective".into(),
             horizon: Some(2),
             budget: None,
+            time_budget_s: None,
             seed: 42 + u64::from(run),
             run,
             quads: 48,

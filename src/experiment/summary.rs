@@ -4,8 +4,9 @@
 //! summary.csv is long-format: one row per (mesh, algo, horizon, metric) with the columns
 //! `mesh,algo,horizon,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers`
 //! (horizon empty for algorithms without one; a `budget` column after it when a group has a
-//! budget, and a `finish` column, "finish" on the rows of the finished groups of `sweep
-//! --finish`, when a group is finished). Metrics: `quality_pct`, `recombined_pct`,
+//! budget, a `time_budget_s` column when a group was calibrated to a time budget (`sweep
+//! --time-budgets`), and a `finish` column, "finish" on the rows of the finished groups of
+//! `sweep --finish`, when a group is finished). Metrics: `quality_pct`, `recombined_pct`,
 //! `time_s`, `nodes_expanded`, `branching_factor`, `mean_eta`, `worst_eta`,
 //! `quads_eta_below_0_1`, `quads_eta_below_0_3` (each only where its runs record it).
 //! summary.json holds the same groups with the outlier values, and the growth fits.
@@ -16,6 +17,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::ExperimentError;
+use super::calibrate::TimeBudget;
 use super::record::RunRecord;
 use crate::stats::describe::{BoxStats, Growth, growth_fit};
 
@@ -49,6 +51,10 @@ pub struct Group {
     /// Node budget per decision, for the budgeted policies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub budget: Option<u32>,
+    /// The wall-time budget its horizon or node budget was calibrated for (`sweep
+    /// --time-budgets`); absent for the others.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_budget_s: Option<super::calibrate::TimeBudget>,
     /// The group's figures are its runs after their finish (`sweep --finish`: the records'
     /// `finish` objects), beside the raw group of the same configuration; absent (false)
     /// for the raw groups. Time is then the finish's alone; no tree figures.
@@ -107,16 +113,22 @@ pub struct Summary {
 
 /// Computes the summary of a set of records.
 pub fn summarize(records: &[RunRecord]) -> Summary {
-    type Key = (String, String, Option<u32>, Option<u32>);
+    type Key = (String, String, Option<u32>, Option<u32>, Option<TimeBudget>);
     let mut by: BTreeMap<Key, Vec<&RunRecord>> = BTreeMap::new();
     for r in records {
-        by.entry((r.mesh.clone(), r.algo.clone(), r.horizon, r.budget))
-            .or_default()
-            .push(r);
+        by.entry((
+            r.mesh.clone(),
+            r.algo.clone(),
+            r.horizon,
+            r.budget,
+            r.time_budget_s,
+        ))
+        .or_default()
+        .push(r);
     }
     let groups: Vec<Group> = by
         .into_iter()
-        .map(|((mesh, algo, horizon, budget), rs)| {
+        .map(|((mesh, algo, horizon, budget, time_budget_s), rs)| {
             let col = |f: &dyn Fn(&RunRecord) -> Option<f64>| -> Vec<f64> {
                 rs.iter()
                     .filter_map(|r| f(r))
@@ -129,6 +141,7 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
                 algo,
                 horizon,
                 budget,
+                time_budget_s,
                 finished: false,
                 n: rs.len(),
                 quality_pct: BoxStats::of(&col(&|r| r.quality_pct)),
@@ -151,12 +164,29 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
     let mut groups = groups;
     groups.extend(finished_groups(records));
     groups.sort_by(|a, b| {
-        (&a.mesh, &a.algo, a.horizon, a.budget, a.finished)
-            .cmp(&(&b.mesh, &b.algo, b.horizon, b.budget, b.finished))
+        (
+            &a.mesh,
+            &a.algo,
+            a.horizon,
+            a.budget,
+            a.time_budget_s,
+            a.finished,
+        )
+            .cmp(&(
+                &b.mesh,
+                &b.algo,
+                b.horizon,
+                b.budget,
+                b.time_budget_s,
+                b.finished,
+            ))
     });
     let mut curves: BTreeMap<(String, String), Vec<(u32, f64)>> = BTreeMap::new();
     for g in &groups {
-        if let (Some(h), Some(t), None, false) = (g.horizon, &g.time_s, g.budget, g.finished) {
+        let timed = g.time_budget_s.is_some();
+        if let (Some(h), Some(t), None, false, false) =
+            (g.horizon, &g.time_s, g.budget, g.finished, timed)
+        {
             curves
                 .entry((g.mesh.clone(), g.algo.clone()))
                 .or_default()
@@ -187,17 +217,23 @@ pub fn summarize(records: &[RunRecord]) -> Summary {
 /// The groups of the finished runs (records with a `finish` object), one per configuration:
 /// quality %, recombined %, the finish's time, mean and worst eta after the finish.
 fn finished_groups(records: &[RunRecord]) -> Vec<Group> {
-    type Key = (String, String, Option<u32>, Option<u32>);
+    type Key = (String, String, Option<u32>, Option<u32>, Option<TimeBudget>);
     let mut by: BTreeMap<Key, Vec<&super::finished::FinishRecord>> = BTreeMap::new();
     for r in records {
         if let Some(f) = &r.finish {
-            by.entry((r.mesh.clone(), r.algo.clone(), r.horizon, r.budget))
-                .or_default()
-                .push(f);
+            by.entry((
+                r.mesh.clone(),
+                r.algo.clone(),
+                r.horizon,
+                r.budget,
+                r.time_budget_s,
+            ))
+            .or_default()
+            .push(f);
         }
     }
     by.into_iter()
-        .map(|((mesh, algo, horizon, budget), fs)| {
+        .map(|((mesh, algo, horizon, budget, time_budget_s), fs)| {
             let col = |f: &dyn Fn(&super::finished::FinishRecord) -> Option<f64>| -> Vec<f64> {
                 fs.iter()
                     .filter_map(|r| f(r))
@@ -209,6 +245,7 @@ fn finished_groups(records: &[RunRecord]) -> Vec<Group> {
                 algo,
                 horizon,
                 budget,
+                time_budget_s,
                 finished: true,
                 n: fs.len(),
                 quality_pct: BoxStats::of(&col(&|f| f.quality_pct)),
@@ -251,11 +288,16 @@ pub fn to_csv(summary: &Summary) -> String {
     // Likewise the finish column ("finish" on the finished groups' rows), only where a group
     // is finished.
     let finish = summary.groups.iter().any(|g| g.finished);
+    // And the time budget column, only where a group was calibrated to one.
+    let timed = summary.groups.iter().any(|g| g.time_budget_s.is_some());
     let mut out = String::from(if budgets {
         "mesh,algo,horizon,budget,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers\n"
     } else {
         "mesh,algo,horizon,metric,n,mean,sd,min,whisker_low,q1,median,q3,whisker_high,max,n_outliers\n"
     });
+    if timed {
+        out = out.replacen(",metric,", ",time_budget_s,metric,", 1);
+    }
     if finish {
         out = out.replacen(",metric,", ",finish,metric,", 1);
     }
@@ -266,6 +308,11 @@ pub fn to_csv(summary: &Summary) -> String {
                 if budgets {
                     h.push(',');
                     h.push_str(&g.budget.map(|b| b.to_string()).unwrap_or_default());
+                }
+                if timed {
+                    h.push(',');
+                    let t = g.time_budget_s.map(|t| t.seconds().to_string());
+                    h.push_str(&t.unwrap_or_default());
                 }
                 if finish {
                     h.push_str(if g.finished { ",finish" } else { "," });

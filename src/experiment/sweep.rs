@@ -321,6 +321,39 @@ impl Worker for SearchWorker<'_> {
     }
 }
 
+/// The calibrations of the sweep's time budgets: a resumed sweep takes its directory's
+/// (never calibrating again: it must make the same runs); an extension takes them and
+/// calibrates only what it adds; a new sweep calibrates every one, by pilot runs on the
+/// prepared meshes with the sweep's threads.
+fn calibration(
+    config: &SweepConfig,
+    prepared: &Prepared,
+    cancel: &AtomicBool,
+    events: &mut Events<'_>,
+) -> Result<Vec<super::calibrate::Calibrated>, ExperimentError> {
+    let dir = config.out();
+    let existing = if config.resume() && dir.join(super::manifest::MANIFEST_FILE).is_file() {
+        Some(Manifest::read(dir)?.spec.calibration)
+    } else {
+        None
+    };
+    match existing {
+        // A plain resume: the directory's own (the engine refuses another configuration).
+        Some(c) if !config.extend() => Ok(c),
+        existing => {
+            let factory = SearchFactory::new(prepared);
+            super::calibrate::calibrate_spec(
+                &prepared.manifest.spec,
+                existing.as_deref().unwrap_or(&[]),
+                &factory,
+                config.threads(),
+                cancel,
+                &mut |note| events(Event::Calibrated(note)),
+            )
+        }
+    }
+}
+
 /// Prepares and runs a sweep into its results directory; `cancel` stops it between runs,
 /// progress and notices go to `events`.
 pub fn run(
@@ -337,7 +370,10 @@ pub fn run_timed(
     cancel: &AtomicBool,
     events: &mut Events<'_>,
 ) -> Result<(Manifest, EngineReport, PhaseTimes), ExperimentError> {
-    let prepared = prepare(config, events)?;
+    let mut prepared = prepare(config, events)?;
+    if !prepared.manifest.spec.time_budgets.is_empty() {
+        prepared.manifest.spec.calibration = calibration(config, &prepared, cancel, events)?;
+    }
     let factory = SearchFactory::new(&prepared);
     let clock = std::time::Instant::now();
     let report = engine::run(

@@ -3,7 +3,10 @@
 //! quality against the measured cost (median tree nodes expanded per decision, and median
 //! time per run), one figure per mesh; and each budgeted configuration against the selective
 //! horizon of the nearest median time at or above its own (the matched cost), Mann-Whitney
-//! with Holm, A12 and bootstrap interval as the report's other comparisons.
+//! with Holm, A12 and bootstrap interval as the report's other comparisons. With time
+//! budgets (`sweep --time-budgets`): per time budget and method, the knob its calibration
+//! chose, the median time measured against the budget and the quality, one figure, and each
+//! policy against selective at the same time budget.
 
 use super::ReportError;
 use super::document::Document;
@@ -48,11 +51,30 @@ pub(super) fn budget_section(
     configs: &[(&Config, &[Run])],
     seed: u64,
 ) -> Result<(), ReportError> {
-    if !configs.iter().any(|(c, _)| c.budget.is_some()) {
+    let timed = configs.iter().any(|(c, _)| c.time_budget.is_some());
+    let nodes = (configs.iter()).any(|(c, _)| c.budget.is_some() && c.time_budget.is_none());
+    if !timed && !nodes {
         return Ok(());
     }
     doc.heading(3, "Quality against budget");
+    if nodes {
+        node_budgets(doc, mesh, configs, seed)?;
+    }
+    if timed {
+        super::time_budget::time_budgets(doc, mesh, configs, seed)?;
+    }
+    Ok(())
+}
+
+/// The node budgets: table, figure and the comparison at matched time.
+fn node_budgets(
+    doc: &mut Document,
+    mesh: &str,
+    configs: &[(&Config, &[Run])],
+    seed: u64,
+) -> Result<(), ReportError> {
     let shown: Vec<(&Config, &[Run])> = (configs.iter().copied())
+        .filter(|(c, _)| c.time_budget.is_none())
         .filter(|(c, _)| c.budget.is_some() || c.algo == "selective")
         .collect();
     let points: Vec<Point> = shown.iter().map(|(c, r)| point(c, r)).collect();

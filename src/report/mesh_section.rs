@@ -56,7 +56,7 @@ pub(super) fn mesh_section(
     // The budgeted configurations have their own section (quality against budget); the
     // horizon sections below read the others.
     let configs: Vec<(&Config, &[Run])> = (every.iter().copied())
-        .filter(|(c, _)| c.budget.is_none())
+        .filter(|(c, _)| c.budget.is_none() && c.time_budget.is_none())
         .collect();
     let configs = if configs.is_empty() {
         every.clone()

@@ -27,6 +27,7 @@ pub mod plots;
 pub mod results;
 pub mod significance;
 mod summarized;
+mod time_budget;
 pub mod typical;
 
 pub use document::{Block, Document};

@@ -29,6 +29,8 @@ pub struct Config {
     pub horizon: Option<u32>,
     /// Node budget per decision, if the algorithm has one.
     pub budget: Option<u32>,
+    /// The wall-time budget its horizon or node budget was calibrated for, if any.
+    pub time_budget: Option<crate::experiment::calibrate::TimeBudget>,
 }
 
 impl Config {
@@ -40,18 +42,24 @@ impl Config {
             algo: run.algo.clone(),
             horizon: run.horizon,
             budget: run.budget,
+            time_budget: run.time_budget_s,
         }
     }
 
-    /// "selective h=3", "mcts h=10 b=64", "greedy".
+    /// "selective h=3", "mcts h=10 b=64", "greedy"; "mcts h=3 b=40 (T=0.2s)" for a
+    /// configuration calibrated to a time budget.
     pub fn label(&self) -> String {
-        crate::experiment::record::label(
+        let label = crate::experiment::record::label(
             &self.algo,
             crate::experiment::record::Params {
                 horizon: self.horizon,
                 budget: self.budget,
             },
-        )
+        );
+        match self.time_budget {
+            Some(t) => format!("{label} (T={}s)", t.seconds()),
+            None => label,
+        }
     }
 }
 

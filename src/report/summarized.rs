@@ -22,6 +22,7 @@ fn finished_or_raw<'s>(summary: &'s Summary, c: &Config, finished: bool) -> Opti
             && g.algo == c.algo
             && g.horizon == c.horizon
             && g.budget == c.budget
+            && g.time_budget_s == c.time_budget
             && g.finished == finished
     })
 }

@@ -17,6 +17,7 @@ mod results;
 mod runner;
 mod runner_budget;
 mod runner_extend;
+mod runner_time_budget;
 mod search;
 mod search_oracle;
 mod suite;

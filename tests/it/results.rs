@@ -149,6 +149,7 @@ fn committed_reports_regenerate_unchanged() {
         "budget-transfer",
         "budget-beam",
         "borouchaki-finish",
+        "budget-time",
     ] {
         let src = repo_path(&format!("results/{case}"));
         if !src.join("report.md").exists() {

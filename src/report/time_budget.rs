@@ -1,0 +1,253 @@
+//! "Quality against budget", by time budget (`sweep --time-budgets`): per time budget and
+//! method, the knob its calibration chose, the median time the runs took against the budget,
+//! and the quality (median and quartiles); where the methods without a knob fall; one
+//! figure; and each policy against selective at the same time budget (Mann-Whitney with
+//! Holm, A12, bootstrap interval, as the report's other comparisons).
+
+use super::ReportError;
+use super::document::Document;
+use super::format::fmt_sig;
+use super::plots::plot_err;
+use super::results::{Config, Metric, Run};
+use super::significance::Family;
+use crate::experiment::calibrate::{TimeBudget, has_knob};
+use crate::stats::describe::{median, quantile};
+use plotters::prelude::*;
+
+/// One configuration calibrated to a time budget.
+struct Row<'a> {
+    config: &'a Config,
+    runs: &'a [Run],
+    t: TimeBudget,
+    time: f64,
+    q: [f64; 3],
+}
+
+/// Appends the time-budget part of the section for `mesh`.
+pub(super) fn time_budgets(
+    doc: &mut Document,
+    mesh: &str,
+    configs: &[(&Config, &[Run])],
+    seed: u64,
+) -> Result<(), ReportError> {
+    let mut rows: Vec<Row<'_>> = (configs.iter())
+        .filter_map(|&(c, runs)| {
+            let t = c.time_budget?;
+            let q = Metric::Quality.values(runs);
+            let time: Vec<f64> = runs.iter().map(|r| r.time_s).collect();
+            Some(Row {
+                config: c,
+                runs,
+                t,
+                time: median(&time),
+                q: [quantile(&q, 0.25), median(&q), quantile(&q, 0.75)],
+            })
+        })
+        .collect();
+    // By time budget, then in the report's order of configurations.
+    rows.sort_by(|a, b| a.t.cmp(&b.t).then_with(|| a.config.cmp(b.config)));
+    let name = Metric::Quality.name(rows[0].runs);
+    doc.para(
+        "By time budget: each time budget T (seconds per run, `sweep --time-budgets`) was \
+         calibrated once, before the runs, into each method's knob: the largest node budget \
+         per decision (optimistic, mcts, beam, at each horizon) or horizon (selective, \
+         uniform) whose median time over a few pilot runs was at most T plus 5 %, so that the \
+         runs replay from their seeds (docs/search.md). The times below are the runs' own, \
+         measured in the sweep beside each other; \"of T\" is their median as a percentage of \
+         T, which shows how close the calibration came (pilots are few, and the machine's \
+         load may differ between calibration and runs).",
+    );
+    doc.table(
+        [
+            "time budget (s)",
+            "configuration",
+            "knob",
+            "runs",
+            "median time (s)",
+            "of T",
+            "q1",
+            "median",
+            "q3",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows.iter()
+            .map(|r| {
+                let c = r.config;
+                let h = c.horizon.unwrap_or(0);
+                vec![
+                    r.t.seconds().to_string(),
+                    c.label(),
+                    match c.budget {
+                        Some(b) => format!("{b} nodes (h = {h})"),
+                        None => format!("h = {h}"),
+                    },
+                    r.runs.len().to_string(),
+                    fmt_sig(r.time, 3),
+                    format!("{:.0} %", 100.0 * r.time / r.t.seconds()),
+                    format!("{:.3}", r.q[0]),
+                    format!("{:.3}", r.q[1]),
+                    format!("{:.3}", r.q[2]),
+                ]
+            })
+            .collect(),
+    );
+    let mut budgets: Vec<TimeBudget> = rows.iter().map(|r| r.t).collect();
+    budgets.dedup();
+    let fixed: Vec<String> = (configs.iter())
+        .filter(|(c, _)| c.time_budget.is_none() && !has_knob(&c.algo))
+        .map(|(c, runs)| {
+            let time: Vec<f64> = runs.iter().map(|r| r.time_s).collect();
+            let t = median(&time);
+            let below = budgets.iter().filter(|b| b.seconds() < t).count();
+            let place = match below {
+                0 => "within every time budget".to_string(),
+                n if n == budgets.len() => "above every time budget".to_string(),
+                n => format!("above {n} of the {} time budgets", budgets.len()),
+            };
+            format!("{} {} s ({place})", c.label(), fmt_sig(t, 3))
+        })
+        .collect();
+    if !fixed.is_empty() {
+        doc.para(format!(
+            "Without a knob to calibrate, run as usual (median time): {}.",
+            fixed.join("; ")
+        ));
+    }
+    let svg = figure(mesh, name, &rows)?;
+    doc.figure(
+        format!(
+            "{}/{}-time-budget.svg",
+            super::FIGURES_DIR,
+            super::format::mesh_slug(mesh)
+        ),
+        svg,
+        format!(
+            "{mesh}: {name} against the time budget per run (log axis), one line per method \
+             and horizon (for the budgeted methods); dots at the medians, bars from the first \
+             to the third quartile."
+        ),
+    );
+    // Each policy against selective at the same time budget.
+    let mut sides = Vec::new();
+    for &t in &budgets {
+        let at: Vec<&Row<'_>> = rows.iter().filter(|r| r.t == t).collect();
+        let Some(sel) = at.iter().find(|r| r.config.algo == "selective") else {
+            continue;
+        };
+        for r in at.iter().filter(|r| r.config.algo != "selective") {
+            sides.push((r.config.label(), r.runs, sel.config.label(), sel.runs));
+        }
+    }
+    if sides.is_empty() {
+        doc.para(
+            "No policy and selective calibrated to the same time budget on this mesh: nothing \
+             to compare at equal time.",
+        );
+        return Ok(());
+    }
+    doc.para(
+        "Each policy against selective calibrated to the same time budget: a policy that wins \
+         there wins at the same cost on this machine.",
+    );
+    let family = Family::build(
+        "Policies against selective at the same time budget, quality".into(),
+        Metric::Quality,
+        sides,
+        seed.wrapping_add(9500),
+    );
+    super::mesh_section::family_blocks(doc, &[family]);
+    Ok(())
+}
+
+/// Colours of the lines (methods, and horizons of the budgeted ones), in order: one more
+/// line than the node-budget figure has (selective and three policies at two horizons).
+const COLORS: [RGBColor; 8] = [
+    RGBColor(220, 20, 20),
+    RGBColor(20, 60, 170),
+    RGBColor(20, 140, 60),
+    RGBColor(150, 60, 170),
+    RGBColor(230, 130, 0),
+    RGBColor(90, 90, 90),
+    RGBColor(0, 170, 190),
+    RGBColor(170, 110, 40),
+];
+
+/// The figure: quality against the time budget, one line per method (and horizon, for the
+/// budgeted methods), IQR bars.
+fn figure(mesh: &str, name: &str, rows: &[Row<'_>]) -> Result<String, ReportError> {
+    let line_of = |r: &Row<'_>| match r.config.budget {
+        Some(_) => format!("{} h={}", r.config.algo, r.config.horizon.unwrap_or(0)),
+        None => r.config.algo.clone(),
+    };
+    let mut lines: Vec<String> = rows.iter().map(line_of).collect();
+    lines.sort_unstable();
+    lines.dedup();
+    let xs = rows.iter().map(|r| r.t.seconds());
+    let (xmin, xmax) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
+    let ys = rows.iter().flat_map(|r| [r.q[0], r.q[2]]);
+    let (ymin, ymax) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+        (a.min(y), b.max(y))
+    });
+    let pad = ((ymax - ymin) * 0.08).max(1e-3);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, super::plots::SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!("{mesh}: quality against time budget"),
+                ("sans-serif", 18),
+            )
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(
+                ((xmin / 1.5)..(xmax * 1.5)).log_scale(),
+                (ymin - pad)..(ymax + pad),
+            )
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("time budget per run (s)")
+            .y_desc(name)
+            .draw()
+            .map_err(plot_err)?;
+        for (i, line) in lines.iter().enumerate() {
+            let color = COLORS[i % COLORS.len()];
+            let mut mine: Vec<&Row<'_>> = rows.iter().filter(|r| line_of(r) == *line).collect();
+            mine.sort_by_key(|r| r.t);
+            chart
+                .draw_series(LineSeries::new(
+                    mine.iter().map(|r| (r.t.seconds(), r.q[1])),
+                    color.stroke_width(2),
+                ))
+                .map_err(plot_err)?
+                .label(line.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color));
+            chart
+                .draw_series(mine.iter().map(|r| {
+                    PathElement::new(
+                        vec![(r.t.seconds(), r.q[0]), (r.t.seconds(), r.q[2])],
+                        color.stroke_width(1),
+                    )
+                }))
+                .map_err(plot_err)?;
+            chart
+                .draw_series(
+                    mine.iter()
+                        .map(|r| Circle::new((r.t.seconds(), r.q[1]), 3, color.filled())),
+                )
+                .map_err(plot_err)?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(plot_err)?;
+        root.present().map_err(plot_err)?;
+    }
+    Ok(svg)
+}
