@@ -62,6 +62,12 @@ impl State<'_> {
                     self.watch_push(t, c, ver);
                 }
             }
+            // Linked groups: every arc's root must stay a root.
+            for i in 0..self.narcs {
+                let root = self.arc_roots[i];
+                self.root_watch[root as usize].push((c, ver));
+                self.base_log(Op::RootWatch(root));
+            }
         }
         let in_split = self.split_pos[ci] != NONE;
         if is_split(r.kind) && !in_split {
