@@ -2,7 +2,7 @@
 //! certificate (watches, split shrinking), the base certificate log, the counts per
 //! triangle and bucket, stale marks and their lazy resolution.
 
-use super::{KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, Op, State, Verdict, is_split};
+use super::{KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict, is_split};
 use crate::mesh::NONE;
 
 impl State<'_> {
@@ -108,7 +108,7 @@ impl State<'_> {
         }
         let ci = c as usize;
         let v = self.cand[ci].verdict;
-        if v.kind != KIND_SPLIT {
+        if v.kind != KIND_SPLIT || v.mask & LINKED != 0 {
             return false;
         }
         let (qc, qy) = (self.cand[ci].quad, self.cand[y as usize].quad);
