@@ -4,7 +4,7 @@
 
 use super::pk::OrderedSets;
 use super::tree::Overlay;
-use super::{CandRecord, State, TriRecord, Verdict};
+use super::{CandRecord, ROOT_TAG, State, TriRecord, Verdict};
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 
@@ -14,6 +14,11 @@ impl<'a> State<'a> {
         let nt = mesh.num_triangles();
         let nv = mesh.vertices.len();
         let m = table.len();
+        // Certificates tag dead-component roots with the top bit (`ROOT_TAG`).
+        assert!(
+            nt < ROOT_TAG as usize && nv < ROOT_TAG as usize,
+            "mesh too large for the search state ({nt} triangles, {nv} vertices)"
+        );
         // The dual graph of the candidates: the mesh's, less the pairs the rule dropped
         // (those sides are boundaries for the criterion, like a surface's).
         let dual = table.dual_graph();

@@ -28,7 +28,7 @@ const LOCAL_OK: [bool; 256] = {
 
 use super::{
     BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT, KIND_SPLIT_LONG,
-    LONG_PART, Op, State, Verdict,
+    LINKED, LONG_PART, Op, ROOT_TAG, State, Verdict,
 };
 use crate::mesh::NONE;
 
@@ -105,17 +105,21 @@ impl State<'_> {
             }
         }
         // Distinct groups of live neighbours: one search per group.
-        let mut sid = [u8::MAX; 4];
-        let mut ns = 0usize;
-        for i in 0..4 {
-            if live[i] {
-                let r = root[i] as usize;
-                if sid[r] == u8::MAX {
-                    sid[r] = ns as u8;
-                    ns += 1;
+        let groups_of = |root: &[u8; 4]| {
+            let mut sid = [u8::MAX; 4];
+            let mut ns = 0usize;
+            for i in 0..4 {
+                if live[i] {
+                    let r = root[i] as usize;
+                    if sid[r] == u8::MAX {
+                        sid[r] = ns as u8;
+                        ns += 1;
+                    }
                 }
             }
-        }
+            (sid, ns)
+        };
+        let (mut sid, mut ns) = groups_of(&root);
         self.nsearch = 0;
         self.narcs = 0;
         let verdict = |allowed: bool, kind: u8| Verdict {
@@ -128,7 +132,10 @@ impl State<'_> {
             return verdict(true, KIND_LOCAL);
         }
         // Where the quad touches the removed region: arcs of touched vertices joined by
-        // touched edges. A split needs one dead component to touch the quad twice.
+        // touched edges, each between two live neighbours (the edge before its first
+        // vertex and the one after its last: a clean vertex's edges are live). A split
+        // needs one dead component to touch the quad twice.
+        let mut arc_link = [(0usize, 0usize); 4];
         let mut distinct = true;
         for i in 0..4 {
             let prev = (i + 3) % 4;
@@ -137,10 +144,14 @@ impl State<'_> {
             // Edge `prev` joins q[prev] and q[i]; touched when its neighbour is gone.
             if touched && (live[prev] || !touched_prev) {
                 let r = self.find(q[i]);
-                if self.arc_roots[..self.narcs].contains(&r) {
-                    distinct = false;
-                    break;
+                distinct &= !self.arc_roots[..self.narcs].contains(&r);
+                // The arc runs over touched edges (whose ends are touched) to a live one;
+                // there is one, since two groups of live neighbours exist.
+                let mut j = i;
+                while !live[j] {
+                    j = (j + 1) % 4;
                 }
+                arc_link[self.narcs] = (prev, j);
                 self.arc_roots[self.narcs] = r;
                 self.narcs += 1;
             }
@@ -148,7 +159,46 @@ impl State<'_> {
         if distinct && self.narcs > 0 {
             return verdict(true, KIND_DISTINCT);
         }
-        self.narcs = 0;
+        // A dead component that touches the quad in one arc only links the live
+        // neighbours on either side of that arc: the frontier of the component (through
+        // remaining triangles, crossing only candidate sides) runs from one to the other
+        // around it, and meets the quad nowhere else. So only components touching it twice
+        // separate groups. The link holds while the arcs' components stay distinct (every
+        // arc's root stays a root: watched) and the clean vertices clean; the roots join
+        // the certificate. (Skipped when the links leave one group: that happens only on a
+        // surface that is not a sphere or plane, where a component touched twice need not
+        // cut; the searches decide those as before.)
+        let mut linked = false;
+        if self.narcs > 2 {
+            let mut root2 = root;
+            for a in 0..self.narcs {
+                let r = self.arc_roots[a];
+                if self.arc_roots[..self.narcs]
+                    .iter()
+                    .filter(|&&x| x == r)
+                    .count()
+                    == 1
+                {
+                    let (b, e) = arc_link[a];
+                    join(&mut root2, b, e);
+                }
+            }
+            let (sid2, ns2) = groups_of(&root2);
+            if ns2 >= 2 && ns2 < ns {
+                (root, sid, ns) = (root2, sid2, ns2);
+                linked = true;
+            }
+        }
+        if !linked {
+            self.narcs = 0;
+        }
+        let vmask = if linked { mask | LINKED } else { mask };
+        let verdict = |allowed: bool, kind: u8| Verdict {
+            allowed,
+            kind,
+            mask: vmask,
+            ..Verdict::default()
+        };
         self.searches += 1;
         self.epoch += 1;
         if self.epoch > EPOCH_LIMIT {
@@ -312,6 +362,10 @@ impl State<'_> {
                 arena.extend_from_slice(&self.queue[s][..self.cert_len[s]]);
             }
         }
+        if kind != KIND_DISTINCT && kind != KIND_LOCAL {
+            // Linked groups: the arcs' roots, tagged.
+            arena.extend(self.arc_roots[..self.narcs].iter().map(|&r| r | ROOT_TAG));
+        }
         (off as u32, (arena.len() - off) as u32)
     }
 
@@ -349,7 +403,19 @@ impl State<'_> {
                 .all(|&r| self.dsu_parent[r as usize] == r)
                 .then_some(true);
         }
-        if !cert.iter().all(|&t| self.alive[t as usize]) {
+        let intact = if v.mask & LINKED == 0 {
+            cert.iter().all(|&t| self.alive[t as usize])
+        } else {
+            cert.iter().all(|&t| {
+                if t & ROOT_TAG == 0 {
+                    self.alive[t as usize]
+                } else {
+                    let r = t & !ROOT_TAG;
+                    self.dsu_parent[r as usize] == r
+                }
+            })
+        };
+        if !intact {
             return None;
         }
         if v.kind == KIND_MET {

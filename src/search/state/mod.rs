@@ -24,6 +24,9 @@
 //!   first triangle, the verdicts watching the two removed triangles, and, when a polder
 //!   changes parity (only an odd polder can split into parts of other parity), the split
 //!   verdicts in the parts that changed. Proof sketch in `docs/search.md`.
+//! * **Linked groups.** A dead component that touches the quad in one arc joins the
+//!   neighbours on either side of it (its frontier runs around it from one to the other), so
+//!   the searches start from fewer groups; such a verdict also watches the arcs' roots.
 //! * Polder ids and sizes are kept per triangle; a split relabels only the finished
 //!   (smaller) parts the search already enumerated.
 //! * `P_k` are kept as bitmaps over triangle ids with a counting Fenwick tree over blocks
@@ -89,6 +92,14 @@ const KIND_SPLIT_LONG: u8 = 4;
 /// polder (a one-cell strip) listing every part made the certificates quadratic in the
 /// strip's length.
 const LONG_PART: usize = 32;
+
+/// `Verdict::mask` bit: the verdict's groups were joined through dead components that
+/// touch the quad once (see `check_slow`); its certificate ends with the roots of every arc,
+/// tagged with [`ROOT_TAG`], which must stay roots.
+const LINKED: u8 = 1 << 7;
+/// Tag of a dead-component root in a triangle certificate (vertex and triangle ids stay
+/// below it).
+const ROOT_TAG: u32 = 1 << 31;
 
 /// A split verdict, listed (`KIND_SPLIT`) or long (`KIND_SPLIT_LONG`).
 #[inline]
@@ -182,14 +193,15 @@ struct Verdict {
     /// `KIND_*`: how it was reached.
     kind: u8,
     /// Bit i: quad vertex i was clean (closed fan, no used triangle) when it was computed;
-    /// the verdict holds only while these stay clean.
+    /// the verdict holds only while these stay clean. Bit 7: [`LINKED`].
     mask: u8,
     /// Split: odd parts among the finished (enumerated) parts.
     fin_odd: u8,
     /// Split: triangles in the finished parts.
     fin_known: u32,
     /// Certificate in its arena (`offset`, `length`): dead-component roots for
-    /// `KIND_DISTINCT`, triangles for `KIND_MET` / `KIND_SPLIT`.
+    /// `KIND_DISTINCT`, triangles for `KIND_MET` / `KIND_SPLIT` (then, for a [`LINKED`]
+    /// verdict, the arcs' roots tagged with [`ROOT_TAG`]).
     cert: u32,
     cert_len: u32,
 }

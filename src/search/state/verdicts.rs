@@ -2,7 +2,7 @@
 //! certificate (watches, split shrinking), the base certificate log, the counts per
 //! triangle and bucket, stale marks and their lazy resolution.
 
-use super::{KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, Op, State, Verdict, is_split};
+use super::{KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict, is_split};
 use crate::mesh::NONE;
 
 impl State<'_> {
@@ -62,6 +62,12 @@ impl State<'_> {
                     self.watch_push(t, c, ver);
                 }
             }
+            // Linked groups: every arc's root must stay a root.
+            for i in 0..self.narcs {
+                let root = self.arc_roots[i];
+                self.root_watch[root as usize].push((c, ver));
+                self.base_log(Op::RootWatch(root));
+            }
         }
         let in_split = self.split_pos[ci] != NONE;
         if is_split(r.kind) && !in_split {
@@ -102,7 +108,7 @@ impl State<'_> {
         }
         let ci = c as usize;
         let v = self.cand[ci].verdict;
-        if v.kind != KIND_SPLIT {
+        if v.kind != KIND_SPLIT || v.mask & LINKED != 0 {
             return false;
         }
         let (qc, qy) = (self.cand[ci].quad, self.cand[y as usize].quad);

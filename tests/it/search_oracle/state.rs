@@ -490,3 +490,32 @@ fn soak_state_matches_oracle() {
         sampled_walk("sphere", &sphere, SEED ^ s, 40, 8);
     }
 }
+
+#[test]
+fn forward_state_keeps_no_linked_split_verdict_across_an_action() {
+    // Regression: a split verdict whose searches started from groups linked through a dead
+    // component touching the quad once was kept across an action inside one of its parts
+    // (`shrink_split`) and went wrong at the 1,500th action of this run (selective h = 5
+    // on the committed grid with holes, the typical run of results/budget-transfer). The
+    // run's actions are replayed on a forward state, every verdict compared with the naive
+    // criterion around that action.
+    use quadrecomb::internals::experiment::replay::{EtaSource, eta_table};
+    use quadrecomb::internals::search::{Algo, Searcher};
+    let path = crate::util::repo_path("results/budget-transfer/grid-5000-holes.msh");
+    let mesh = quadrecomb::internals::mesh::load(path.to_str().expect("utf-8 path"))
+        .expect("the committed mesh");
+    let (table, _) =
+        eta_table(&mesh, EtaSource::CpuTwin, Rule::Valid { min_eta: 0.0 }).expect("the CPU twin");
+    let out = Searcher::new(&mesh, &table).run(Algo::selective(5), 8040697979896814);
+    assert!(out.chosen.len() > 1510, "the run reaches the action");
+    let mut state = State::new(&mesh, &table);
+    state.set_forward_uncopied();
+    for (i, &c) in out.chosen.iter().enumerate().take(1510) {
+        if i >= 1490 {
+            state
+                .sanity_check()
+                .unwrap_or_else(|e| panic!("after {i} actions: {e}"));
+        }
+        state.apply(c);
+    }
+}
