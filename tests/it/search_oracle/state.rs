@@ -519,3 +519,84 @@ fn forward_state_keeps_no_linked_split_verdict_across_an_action() {
         state.apply(c);
     }
 }
+
+/// Long soak over whole policy runs, not run by default (`cargo test --release --test it
+/// soak_policy -- --ignored`): on every mesh of the default suite and the committed grid with
+/// holes, under both rules, greedy and selective h = 1, 3 and 5 (two seeds each) are run, and
+/// their actions replayed on the naive oracle: each chosen action must be one the naive
+/// criterion allows, and every 97th action a forward state's verdict on a sample of
+/// candidates (the action's neighbourhood and random ones) must equal the oracle's, both
+/// ways (a wrongly forbidden action changes a run silently; the sample catches it).
+#[test]
+#[ignore]
+fn soak_policy_runs_match_the_oracle() {
+    use quadrecomb::internals::experiment::replay::{EtaSource, eta_table};
+    use quadrecomb::internals::search::{Algo, Searcher};
+    let mut names: Vec<String> = quadrecomb::internals::mesh::suite::SUITES
+        .iter()
+        .find(|(n, _, _)| *n == "default")
+        .expect("the default suite")
+        .1
+        .iter()
+        .map(|m| format!("suite:{m}"))
+        .collect();
+    names.push(
+        crate::util::repo_path("results/budget-transfer/grid-5000-holes.msh")
+            .to_string_lossy()
+            .into_owned(),
+    );
+    let mut checked = 0usize;
+    for name in &names {
+        let mesh = quadrecomb::internals::mesh::load(name).expect("a suite mesh");
+        for rule in [Rule::Valid { min_eta: 0.0 }, Rule::AllPairs] {
+            let (table, _) = eta_table(&mesh, EtaSource::CpuTwin, rule).expect("the CPU twin");
+            let nc = table.len() as u32;
+            let algos = [
+                Algo::greedy(),
+                Algo::selective(1),
+                Algo::selective(3),
+                Algo::selective(5),
+            ];
+            for algo in algos {
+                for seed in [11u64, 8040697979896814] {
+                    let out = Searcher::new(&mesh, &table).run(algo, seed);
+                    let mut oracle = super::naive::Naive::new(&mesh, &table);
+                    let mut state = State::new(&mesh, &table);
+                    state.set_forward_uncopied();
+                    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+                    for (i, &c) in out.chosen.iter().enumerate() {
+                        let at = || format!("{name}, {rule:?}, {algo:?}, seed {seed}, action {i}");
+                        assert!(oracle.is_allowed(c), "chose a forbidden action: {}", at());
+                        if i % 97 == 0 {
+                            let mut sample: Vec<u32> =
+                                (0..24).map(|_| rng.random_range(0..nc)).collect();
+                            for t in table.pairs[c as usize] {
+                                sample.extend(
+                                    table.by_triangle[t as usize]
+                                        .iter()
+                                        .filter(|&&d| d != quadrecomb::internals::mesh::NONE),
+                                );
+                            }
+                            for d in sample {
+                                assert_eq!(
+                                    state.is_allowed(d),
+                                    oracle.is_allowed(d),
+                                    "is_allowed({d}): {}",
+                                    at()
+                                );
+                                checked += 1;
+                            }
+                        }
+                        oracle.apply(c);
+                        state.apply(c);
+                    }
+                    assert!(
+                        state.allowed_actions().is_empty(),
+                        "{name}, {rule:?}, {algo:?}, seed {seed}: the run stopped with allowed actions left"
+                    );
+                }
+            }
+        }
+    }
+    assert!(checked > 10_000, "{checked} verdicts compared");
+}
