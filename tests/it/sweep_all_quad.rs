@@ -3,7 +3,7 @@
 //! rebuilds the split mesh from the record and `-o` writes the finished mesh, as meshio reads
 //! it; other all-quad settings are refused on resume.
 
-use crate::all_quad::{check_written, without, write_input};
+use crate::all_quad::{Checked, check_written, without, write_input};
 use crate::runner::{records, stderr, sweep};
 use crate::util::{SEED, python, python_module_available, run_in};
 use quadrecomb::internals::experiment::manifest::Manifest;
@@ -108,7 +108,10 @@ fn sweep_finish_all_quad_records_splits_and_replay_writes_the_finished_mesh() {
     assert_eq!(v["finish"]["all_quad"]["splits"], 1);
     assert_eq!(v["finish"]["quads"], v["recorded"]["finish"]["quads"]);
     if python_module_available("meshio") {
-        assert_eq!(check_written(&dir.join("one.msh"), &dir.join("r.msh")), 1);
+        assert_eq!(
+            check_written(&dir.join("one.msh"), &dir.join("r.msh")),
+            Checked::of_splits(1)
+        );
     }
 
     // Without --all-quad the settings differ: resume refuses.
