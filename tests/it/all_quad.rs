@@ -32,7 +32,7 @@ pub(crate) fn without(mesh: &Mesh, drop: &[u32]) -> Mesh {
     compact(&mesh.vertices, triangles)
 }
 
-fn compact(vertices: &[[f64; 3]], triangles: Vec<[u32; 3]>) -> Mesh {
+pub(crate) fn compact(vertices: &[[f64; 3]], triangles: Vec<[u32; 3]>) -> Mesh {
     let mut new_of = vec![u32::MAX; vertices.len()];
     let mut kept = Vec::new();
     let triangles = triangles
