@@ -240,6 +240,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     super::finish_report::SPLIT_PLACE,
                     rf.splits()
                 );
+                if a.sheets > 0 {
+                    println!(
+                        "sheets          {} sheets, {} nodes, {} triangles replaced by {} (recorded {} triangles added)",
+                        a.sheets,
+                        a.sheet_nodes,
+                        a.sheet_triangles_replaced,
+                        a.sheet_triangles_replaced + a.sheet_triangles_added,
+                        rf.triangles_added()
+                    );
+                }
             }
         }
         let same = if out.reproduced { "yes" } else { "no" };

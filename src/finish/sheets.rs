@@ -45,7 +45,7 @@ pub enum SheetError {
     },
     /// A new quad is not a pair the rule allows (a degenerate or near-degenerate element).
     #[error(
-        "all-quad sheet refinement: the new quad of nodes {nodes:?} made from element {element} (surface {surface}) has eta {eta}, which the rule does not allow (element {element} is degenerate or nearly so)"
+        "all-quad sheet refinement: the new quad of nodes {nodes:?} made from element {element} (surface {surface}) has eta {eta}, which the rule does not allow (element {element} is degenerate or nearly so, or --min-eta is above what halving the quads a sheet crosses keeps)"
     )]
     InvalidQuad {
         element: u64,
