@@ -236,13 +236,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 println!(
                     "all-quad        {} boundary sides split, {} nodes added {} (recorded {})",
                     a.splits,
-                    a.nodes_added,
+                    a.splits,
                     super::finish_report::SPLIT_PLACE,
                     rf.splits()
                 );
                 if a.sheets > 0 {
                     println!(
-                        "sheets          {} sheets, {} nodes, {} triangles replaced by {} (recorded {} triangles added)",
+                        "sheets          {} sheets, {} nodes added (inside and on sides), {} triangles replaced by {} (recorded {} triangles added in all)",
                         a.sheets,
                         a.sheet_nodes,
                         a.sheet_triangles_replaced,
