@@ -93,8 +93,8 @@ fn code(e: &(dyn Error + 'static)) -> Option<u8> {
     if let Some(e) = e.downcast_ref::<ExperimentError>() {
         return experiment_code(e);
     }
-    if let Some(quadrecomb::internals::finish::FinishError::NotAllQuad(_)) = e.downcast_ref() {
-        // The mesh has a component no boundary split can make all-quad.
+    if let Some(quadrecomb::internals::finish::FinishError::Sheet(_)) = e.downcast_ref() {
+        // The mesh has a component sheet refinement cannot make all-quad.
         return Some(EXIT_BAD_INPUT);
     }
     match e.downcast_ref::<ReportError>()? {

@@ -37,6 +37,12 @@ pub fn json(
             "side": s.side, "node": s.node, "path_len": s.path_len,
         })).collect::<Vec<_>>(),
         "split_place": (!f.splits.is_empty()).then_some("chord"),
+        "sheets": (f.sheets.sheets > 0).then(|| serde_json::json!({
+            "sheets": f.sheets.sheets,
+            "nodes_added": f.sheets.nodes,
+            "triangles_replaced": f.sheets.triangles_replaced,
+            "triangles_added": f.sheets.triangles_added,
+        })),
         "regions": f.stats.regions,
         "max_rings": f.stats.max_rings,
         "passes": f.stats.passes,
@@ -80,6 +86,16 @@ pub fn print(f: &Finished, table: &CandidateTable, pct: impl Fn(f64) -> Option<f
                 s.side[0], s.side[1], s.node, s.path_len
             );
         }
+    }
+    if f.sheets.sheets > 0 {
+        println!(
+            "  sheets        {} sheets through the components no split fixes: {} nodes added, {} triangles replaced by {} (as quads: {})",
+            f.sheets.sheets,
+            f.sheets.nodes,
+            f.sheets.triangles_replaced,
+            f.sheets.triangles_replaced + f.sheets.triangles_added,
+            (f.sheets.triangles_replaced + f.sheets.triangles_added) / 2
+        );
     }
     println!("  finish time   {:.4} s", f.time_s());
 }

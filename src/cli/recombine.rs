@@ -82,7 +82,8 @@ pub struct FinishArgs {
     #[arg(long)]
     pub finish: bool,
     /// With --finish: also make odd components even by splitting a boundary side (a new node
-    /// at its midpoint, on the chord), so that no triangle is left where a split allows.
+    /// at its midpoint, on the chord), and refine by sheets the components no split fixes,
+    /// so that no triangle is left.
     #[arg(long, requires = "finish")]
     pub all_quad: bool,
     /// With --finish: rings of quads around the leftovers in the first elimination round (k,

@@ -249,10 +249,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 println!(
                     "all-quad        {} boundary sides split, {} nodes added {} (recorded {})",
                     a.splits,
-                    a.nodes_added,
+                    a.splits,
                     super::finish_report::SPLIT_PLACE,
                     rf.splits()
                 );
+                if a.sheets > 0 {
+                    println!(
+                        "sheets          {} sheets, {} nodes added (inside and on sides), {} triangles replaced by {} (recorded {} triangles added in all)",
+                        a.sheets,
+                        a.sheet_nodes,
+                        a.sheet_triangles_replaced,
+                        a.sheet_triangles_replaced + a.sheet_triangles_added,
+                        rf.triangles_added()
+                    );
+                }
             }
         }
         let same = if out.reproduced { "yes" } else { "no" };

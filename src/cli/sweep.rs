@@ -140,8 +140,9 @@ pub struct SweepFinishArgs {
     #[arg(long, requires = "finish", default_value_t = quadrecomb::internals::finish::DEFAULT_WINDOW)]
     window: u32,
     /// With --finish: also make odd components even by splitting a boundary side (a new node
-    /// at its midpoint, on the chord), so that no triangle is left. Records then count the
-    /// split mesh's triangles and add `finish.all_quad` (splits, nodes added); replay
+    /// at its midpoint, on the chord), or by sheets where no split fixes a component, so that
+    /// no triangle is left. Records then count the split mesh's triangles and add
+    /// `finish.all_quad` (splits, nodes added, sheets when any); replay
     /// rebuilds the split mesh from the record.
     #[arg(long, requires = "finish")]
     all_quad: bool,

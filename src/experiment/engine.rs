@@ -297,7 +297,7 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
     if let Some(f) = &r.finish {
         f.check(r.triangles)?;
         if let Some(opt) = optimum {
-            if f.quads > opt.quads + f.splits() {
+            if f.quads > opt.quads + f.triangles_added() {
                 return Err(format!(
                     "finish: {} quads, more than the {} of its mesh's optimum",
                     f.quads, opt.quads

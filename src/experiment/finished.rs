@@ -74,10 +74,34 @@ pub struct FinishOutcome {
 pub struct AllQuadFigures {
     /// Boundary sides split (one per odd component that kept a triangle).
     pub splits: usize,
-    /// Nodes added to the mesh (one per split, on the chord of the side).
+    /// Nodes added to the mesh (one per split, on the chord of the side, and those of the
+    /// sheets).
     pub nodes_added: usize,
     /// Seconds of all-quad (the choice of the splits, the new mesh, its elimination).
     pub time_s: f64,
+    /// Sheets of sheet refinement, for the components no single split fixes (0: absent).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub sheets: usize,
+    /// Nodes the sheets added (within `nodes_added`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub sheet_nodes: usize,
+    /// Triangles of the (split) mesh the sheets replaced.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub sheet_triangles_replaced: usize,
+    /// Triangles the sheets added to the mesh.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub sheet_triangles_added: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
+impl AllQuadFigures {
+    /// Triangles added to the mesh: one per split, and the sheets'.
+    pub fn triangles_added(&self) -> usize {
+        self.splits + self.sheet_triangles_added
+    }
 }
 
 /// The finished mesh of a run: the split mesh when all-quad split (else `None`: the input),
@@ -127,8 +151,12 @@ pub fn finish_run_with_mesh(
         elements: ElementQuality::of_chosen(t, &f.chosen),
         all_quad: f.all_quad.map(|s| AllQuadFigures {
             splits: f.splits.len(),
-            nodes_added: f.splits.len(),
+            nodes_added: f.splits.len() + f.sheets.nodes,
             time_s: s.time_s,
+            sheets: f.sheets.sheets,
+            sheet_nodes: f.sheets.nodes,
+            sheet_triangles_replaced: f.sheets.triangles_replaced,
+            sheet_triangles_added: f.sheets.triangles_added,
         }),
     };
     let rec = recombined(f.mesh(mesh), t, &f.chosen);
@@ -171,7 +199,8 @@ pub struct FinishRecord {
     /// time stays in the record's `time_s`.
     pub time_s: f64,
     /// What all-quad did (`sweep --finish --all-quad` only; absent otherwise). With splits,
-    /// the counts above are of the split mesh (`triangles + splits` triangles).
+    /// the counts above are of the split mesh (`triangles + splits + sheet_triangles_added`
+    /// triangles).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub all_quad: Option<AllQuadFigures>,
 }
@@ -185,7 +214,7 @@ impl FinishRecord {
         triangles: usize,
         optimum: Option<f64>,
     ) -> FinishRecord {
-        let triangles = triangles + out.all_quad.map_or(0, |a| a.splits);
+        let triangles = triangles + out.all_quad.map_or(0, |a| a.triangles_added());
         FinishRecord {
             rings: settings.rings,
             window: settings.window,
@@ -209,9 +238,14 @@ impl FinishRecord {
         }
     }
 
-    /// Triangles added by all-quad's splits (0 without).
+    /// Boundary sides all-quad split (0 without).
     pub fn splits(&self) -> usize {
         self.all_quad.map_or(0, |a| a.splits)
+    }
+
+    /// Triangles added by all-quad's splits and sheets (0 without).
+    pub fn triangles_added(&self) -> usize {
+        self.all_quad.map_or(0, |a| a.triangles_added())
     }
 
     /// The object with its times zeroed (for comparing results, not executions).
@@ -228,21 +262,22 @@ impl FinishRecord {
     /// Why the object holds values no finish of a run on `triangles` triangles can have
     /// (counts that do not add up, measures out of range), if it does.
     pub fn check(&self, triangles: usize) -> Result<(), String> {
-        let splits = self.splits();
-        if 2 * self.quads as u128 + self.triangles_left as u128
-            != triangles as u128 + splits as u128
+        let added = self.triangles_added();
+        if 2 * self.quads as u128 + self.triangles_left as u128 != triangles as u128 + added as u128
         {
             return Err(format!(
-                "finish: 2 x {} quads + {} triangles left is not its {triangles} triangles + {splits} split",
+                "finish: 2 x {} quads + {} triangles left is not its {triangles} triangles + {added} added by all-quad",
                 self.quads, self.triangles_left
             ));
         }
         if let Some(a) = self.all_quad
-            && (a.nodes_added != a.splits || !a.time_s.is_finite() || a.time_s < 0.0)
+            && (a.nodes_added != a.splits + a.sheet_nodes
+                || !a.time_s.is_finite()
+                || a.time_s < 0.0)
         {
             return Err(format!(
-                "finish: all_quad {} nodes added for {} splits, time {}",
-                a.nodes_added, a.splits, a.time_s
+                "finish: all_quad {} nodes added for {} splits and {} sheet nodes, time {}",
+                a.nodes_added, a.splits, a.sheet_nodes, a.time_s
             ));
         }
         for (name, v) in [

@@ -269,7 +269,9 @@ impl<'m> Replayer<'m> {
         let reproduced = same(quads, quality, record.quads, record.quality)
             && match (&finish, &record.finish) {
                 (Some(a), Some(b)) => {
-                    same(a.quads, a.quality, b.quads, b.quality) && a.splits() == b.splits()
+                    same(a.quads, a.quality, b.quads, b.quality)
+                        && a.splits() == b.splits()
+                        && a.triangles_added() == b.triangles_added()
                 }
                 _ => true,
             };

@@ -166,7 +166,13 @@ pub(crate) fn split(
 
 /// Splits the model's line element on side `p`-`q` (if any) at the new node `m`, and
 /// classifies `m` on that curve, or on surface `surface` when no line element lies there.
-fn split_model_edge(model: &mut crate::mesh::msh::Model, p: u32, q: u32, m: u32, surface: i32) {
+pub(crate) fn split_model_edge(
+    model: &mut crate::mesh::msh::Model,
+    p: u32,
+    q: u32,
+    m: u32,
+    surface: i32,
+) {
     let mut entity = (2u8, surface);
     let mut halves = None;
     for (i, e) in model.elements.iter().enumerate() {

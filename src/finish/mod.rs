@@ -7,16 +7,19 @@
 //! k doubling until every leftover that can be paired is, or its component is proven to
 //! leave it), [`all_quad`] (optional: one leftover per odd component moved to the boundary,
 //! a boundary side split where [`split_choice`] proves it makes the component perfectly
-//! matchable, eliminated again), `improve` (windows of r rings swept until a
+//! matchable, eliminated again; the components no such split fixes refined by [`sheets`]),
+//! `improve` (windows of r rings swept until a
 //! pass gains nothing). Imports `mesh`, `quality` and `search::optimum` only.
 
 pub mod all_quad;
 mod improve;
 mod leftovers;
 mod region;
+pub mod sheets;
 pub mod split_choice;
 
 pub use all_quad::Split;
+pub use sheets::{SheetError, SheetStats};
 pub use split_choice::{Stuck, StuckReason};
 
 use crate::mesh::{Mesh, MeshError};
@@ -56,23 +59,16 @@ pub enum FinishError {
     /// All-quad's split made an invalid mesh (it should not: boundary sides halved).
     #[error("all-quad split: {0}")]
     Mesh(#[from] MeshError),
-    /// All-quad cannot leave every triangle paired: the components no boundary split fixes.
-    #[error("all-quad cannot pair every triangle: {}", join(.0))]
-    NotAllQuad(Vec<Stuck>),
+    /// All-quad's sheet refinement cannot refine the mesh (a side shared with an input quad,
+    /// a degenerate triangle).
+    #[error(transparent)]
+    Sheet(#[from] SheetError),
     /// The split mesh still leaves triangles although each split was checked to make its
     /// component perfectly matchable (a bug).
     #[error(
         "all-quad: the split mesh still leaves {0} triangles, although each split was checked to make its component perfectly matchable (a bug)"
     )]
     SplitLeft(usize),
-}
-
-fn join(stuck: &[Stuck]) -> String {
-    stuck
-        .iter()
-        .map(|s| s.to_string())
-        .collect::<Vec<_>>()
-        .join("; ")
 }
 
 /// Default first ring count of elimination.
@@ -123,6 +119,8 @@ pub struct Finished {
     pub improved: StepFigures,
     /// The sides split by all-quad (empty without it, or when nothing was odd).
     pub splits: Vec<Split>,
+    /// What all-quad's sheet refinement changed (zero when single splits sufficed).
+    pub sheets: SheetStats,
     /// The mesh with the split triangles, when all-quad split any.
     pub mesh: Option<Mesh>,
     /// Its candidate table under the same rule.
@@ -159,8 +157,9 @@ fn figures(table: &CandidateTable, pairing: &Pairing, time_s: f64) -> StepFigure
 }
 
 /// Finishes the pairing `chosen` (candidates of `table`, a matching) of `mesh`. Errors only
-/// with all-quad: when a component keeps triangles that no boundary split can pair
-/// ([`FinishError::NotAllQuad`], naming each), or (a bug) when a split goes wrong.
+/// with all-quad: when sheet refinement cannot refine a component no boundary split fixes
+/// ([`FinishError::Sheet`]: a sheet meets an input quad, a degenerate triangle), or (a bug)
+/// when a split goes wrong.
 pub fn finish(
     mesh: &Mesh,
     table: &CandidateTable,
@@ -181,6 +180,7 @@ pub fn finish(
     let mut split_mesh = None;
     let mut all_quad = None;
     let mut splits = Vec::new();
+    let mut sheet_stats = SheetStats::default();
     if config.all_quad {
         let t1 = Instant::now();
         if pairing.leftovers().next().is_some() {
@@ -191,23 +191,38 @@ pub fn finish(
                 config.rule,
                 config.rings,
                 &mut stats.regions,
-            )
-            .map_err(FinishError::NotAllQuad)?;
-            let s = all_quad::split(mesh, table, &chosen, config.rule)?;
-            let n = s.mesh.num_triangles();
-            let mut p = s.pairing;
-            (rings, solver) = (Rings::new(n), RegionSolver::new(n));
-            // Pairs a half whose pair the new table computed otherwise (rounding) too.
-            let e = leftovers::eliminate(&s.table, &mut p, &mut rings, &mut solver, config.rings);
-            stats.regions += e.regions;
-            stats.max_rings = stats.max_rings.max(e.max_rings);
-            let left = p.leftovers().count();
-            if left > 0 {
+            );
+            let stuck = chosen.stuck.len();
+            if !chosen.choices.is_empty() {
+                let s = all_quad::split(mesh, table, &chosen, config.rule)?;
+                let n = s.mesh.num_triangles();
+                let mut p = s.pairing;
+                (rings, solver) = (Rings::new(n), RegionSolver::new(n));
+                // Pairs a half whose pair the new table computed otherwise (rounding) too.
+                let e =
+                    leftovers::eliminate(&s.table, &mut p, &mut rings, &mut solver, config.rings);
+                stats.regions += e.regions;
+                stats.max_rings = stats.max_rings.max(e.max_rings);
+                pairing = p;
+                splits = s.splits;
+                split_mesh = Some((s.mesh, s.table));
+            } else {
+                pairing = chosen.pairing;
+            }
+            let left = pairing.leftovers().count();
+            if left > 0 && stuck == 0 {
                 return Err(FinishError::SplitLeft(left));
             }
-            pairing = p;
-            splits = s.splits;
-            split_mesh = Some((s.mesh, s.table));
+            if left > 0 {
+                // The components no single split fixes: sheet refinement.
+                let (m, t) = split_mesh.as_ref().map_or((mesh, table), |(m, t)| (m, t));
+                let r = sheets::refine(m, t, &pairing, config.rule)?;
+                let n = r.mesh.num_triangles();
+                (rings, solver) = (Rings::new(n), RegionSolver::new(n));
+                pairing = r.pairing;
+                sheet_stats = r.stats;
+                split_mesh = Some((r.mesh, r.table));
+            }
         }
         let t = split_mesh.as_ref().map_or(table, |(_, t)| t);
         all_quad = Some(figures(t, &pairing, t1.elapsed().as_secs_f64()));
@@ -232,6 +247,7 @@ pub fn finish(
         all_quad,
         improved,
         splits,
+        sheets: sheet_stats,
         mesh,
         table,
         stats,

@@ -41,6 +41,8 @@ pub(crate) struct Choice {
 pub(crate) struct Chosen {
     pub choices: Vec<Choice>,
     pub pairing: Pairing,
+    /// The components no split fixes (their leftovers stay in `pairing`).
+    pub stuck: Vec<Stuck>,
 }
 
 /// Why no boundary split makes a component perfectly matchable.
@@ -167,7 +169,7 @@ fn is_pair(table: &CandidateTable, a: u32, b: u32) -> bool {
 
 /// Chooses one split per component that keeps a triangle in `pairing` (a maximum matching of
 /// `table`'s dual graph, as elimination leaves it), each checked exactly; the components no
-/// split can fix otherwise. `regions` counts the regions re-solved.
+/// split can fix are named in [`Chosen::stuck`]. `regions` counts the regions re-solved.
 pub(crate) fn choose(
     mesh: &Mesh,
     table: &CandidateTable,
@@ -175,7 +177,7 @@ pub(crate) fn choose(
     rule: Rule,
     first_rings: u32,
     regions: &mut usize,
-) -> Result<Chosen, Vec<Stuck>> {
+) -> Chosen {
     let nt = pairing.cand.len();
     let mut is_boundary = vec![false; mesh.topology.edges.len()];
     for &e in &mesh.topology.boundary_edges {
@@ -326,13 +328,10 @@ pub(crate) fn choose(
             })),
         }
     }
-    if stuck.is_empty() {
-        Ok(Chosen {
-            choices,
-            pairing: p,
-        })
-    } else {
-        Err(stuck)
+    Chosen {
+        choices,
+        pairing: p,
+        stuck,
     }
 }
 

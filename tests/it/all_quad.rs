@@ -6,7 +6,9 @@
 //! them (`all_quad_check.py`).
 
 use crate::util::{python, python_module_available, run_in};
-use quadrecomb::internals::finish::{FinishConfig, FinishError, Finished, StuckReason, finish};
+use quadrecomb::internals::finish::{
+    FinishConfig, FinishError, Finished, SheetError, SheetStats, finish,
+};
 use quadrecomb::internals::mesh::generate::{GridSpec, grid, lattice};
 use quadrecomb::internals::mesh::{Mesh, MeshData};
 use quadrecomb::internals::quality::{self, CandidateTable, Rule};
@@ -30,7 +32,7 @@ pub(crate) fn without(mesh: &Mesh, drop: &[u32]) -> Mesh {
     compact(&mesh.vertices, triangles)
 }
 
-fn compact(vertices: &[[f64; 3]], triangles: Vec<[u32; 3]>) -> Mesh {
+pub(crate) fn compact(vertices: &[[f64; 3]], triangles: Vec<[u32; 3]>) -> Mesh {
     let mut new_of = vec![u32::MAX; vertices.len()];
     let mut kept = Vec::new();
     let triangles = triangles
@@ -189,47 +191,28 @@ fn oracle(mesh: &Mesh) -> (Vec<u32>, Vec<Verdict>) {
     (component, verdicts)
 }
 
-/// Checks all-quad's outcome on `mesh` against the oracle: it succeeds exactly when every
-/// component that keeps triangles is fixable, with one split per such component at most;
-/// otherwise it names exactly the components the oracle cannot fix. True if it succeeded.
+/// Checks all-quad's outcome on `mesh` against the oracle: it always leaves no triangle;
+/// single splits alone (one per component that keeps triangles at most) exactly when every
+/// such component is fixable, sheet refinement otherwise. True if it needed sheets.
 fn agrees_with_oracle(mesh: &Mesh, seed: u64, what: &str, written: &mut Written) -> bool {
-    let (component, verdicts) = oracle(mesh);
-    let unfixable: Vec<u32> = verdicts
-        .iter()
-        .filter(|v| !v.fixable)
-        .map(|v| v.component)
-        .collect();
-    match all_quad_into(mesh, seed, Some(written)) {
-        Ok(splits) => {
-            assert!(
-                unfixable.is_empty(),
-                "{what}: succeeded where the oracle says no"
-            );
-            assert!(splits <= verdicts.len(), "{what}");
-            true
-        }
-        Err(FinishError::NotAllQuad(stuck)) => {
-            let mut named: Vec<u32> = stuck
-                .iter()
-                .map(|s| {
-                    let t = mesh
-                        .triangle_ids
-                        .iter()
-                        .position(|&id| id == s.element)
-                        .unwrap();
-                    component[t]
-                })
-                .collect();
-            named.sort_unstable();
-            assert_eq!(named, unfixable, "{what}: {stuck:?} vs {verdicts:?}");
-            for s in &stuck {
-                let v = verdicts.iter().find(|v| v.left == s.left && !v.fixable);
-                assert!(v.is_some(), "{what}: {s:?} vs {verdicts:?}");
-            }
-            false
-        }
-        Err(e) => panic!("{what}: {e}"),
+    let (_, verdicts) = oracle(mesh);
+    let unfixable = verdicts.iter().filter(|v| !v.fixable).count();
+    let f = all_quad_into(mesh, seed, Some(written)).unwrap_or_else(|e| panic!("{what}: {e}"));
+    assert!(f.splits.len() <= verdicts.len(), "{what}");
+    assert_eq!(
+        f.sheets.sheets > 0,
+        unfixable > 0,
+        "{what}: sheets {:?} vs {verdicts:?}",
+        f.sheets
+    );
+    if unfixable > 0 {
+        // At least the unfixable components' leftovers were refined: 3 quads each.
+        assert!(
+            f.sheets.sheets >= 3 && f.sheets.triangles_replaced >= 1,
+            "{what}"
+        );
     }
+    f.sheets.sheets > 0
 }
 
 /// Strict convexity from the corners alone (planar meshes).
@@ -243,19 +226,16 @@ fn strictly_convex(p: [[f64; 3]; 4]) -> bool {
     cross.iter().all(|&x| x > 0.0) || cross.iter().all(|&x| x < 0.0)
 }
 
-/// All-quad on `mesh` from a selective run of `seed`: `Ok(splits)` with every check passed
+/// All-quad on `mesh` from a selective run of `seed`: `Ok(finished)` with every check passed
 /// (no triangle left, quads strictly convex and a matching, the new mesh valid with one node
-/// and one triangle per split, each node the midpoint of its side), or the error.
-fn all_quad(mesh: &Mesh, seed: u64) -> Result<usize, FinishError> {
-    all_quad_into(mesh, seed, None)
-}
-
-/// [`all_quad`], writing the input and the result into `written` when it succeeds.
+/// and one triangle per split and the sheets' nodes and triangles, each split's node the
+/// midpoint of its side), or the error; the input and the result written into `written`
+/// when it succeeds.
 fn all_quad_into(
     mesh: &Mesh,
     seed: u64,
     written: Option<&mut Written>,
-) -> Result<usize, FinishError> {
+) -> Result<Finished, FinishError> {
     let table = valid_table(mesh);
     let run = Searcher::new(mesh, &table).run(Algo::selective(1), seed);
     let config = FinishConfig {
@@ -265,8 +245,12 @@ fn all_quad_into(
     let f = finish(mesh, &table, &run.chosen, config)?;
     let (m, t) = (f.mesh(mesh), f.table(&table));
     m.sanity_check().unwrap();
-    assert_eq!(m.num_triangles(), mesh.num_triangles() + f.splits.len());
-    assert_eq!(m.vertices.len(), mesh.vertices.len() + f.splits.len());
+    let added = f.splits.len() + f.sheets.triangles_added;
+    assert_eq!(m.num_triangles(), mesh.num_triangles() + added);
+    assert_eq!(
+        m.vertices.len(),
+        mesh.vertices.len() + f.splits.len() + f.sheets.nodes
+    );
     assert_eq!(2 * f.chosen.len(), m.num_triangles(), "all paired");
     assert_eq!(f.improved.triangles_left, 0);
     let mut used = vec![false; m.num_triangles()];
@@ -288,7 +272,18 @@ fn all_quad_into(
     if let Some(w) = written {
         w.add(mesh, &f, &table);
     }
-    Ok(f.splits.len())
+    Ok(f)
+}
+
+/// What the written file of `f` must show: one node and one triangle per split, and the
+/// sheets' nodes and triangles (at least the splits' nodes on the boundary).
+fn expected(f: &Finished) -> Checked {
+    let splits = f.splits.len();
+    Checked {
+        new_nodes: splits + f.sheets.nodes,
+        new_boundary_nodes: splits,
+        triangles_added: splits + f.sheets.triangles_added,
+    }
 }
 
 /// Odd components of the valid-pair dual graph.
@@ -311,19 +306,21 @@ fn all_quad_pairs_every_triangle_of_the_612_lattice_without_its_corner() {
         let (_, verdicts) = oracle(&mesh);
         assert_eq!(verdicts.len(), 1);
         assert!(verdicts[0].fixable, "seed {seed}: the oracle finds a split");
-        let splits = all_quad_into(&mesh, seed, Some(&mut written))
+        let f = all_quad_into(&mesh, seed, Some(&mut written))
             .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
-        assert_eq!(splits, 1);
+        assert_eq!(f.splits.len(), 1);
+        assert_eq!(f.sheets.sheets, 0, "seed {seed}: one split suffices");
     }
     assert!(matches!(written.check(), None | Some(4)));
 }
 
 /// Lattices with several corners or inner triangles removed (holes whose sides are
-/// boundary): all-quad succeeds exactly where the oracle finds a split for every component
-/// that keeps a triangle, and names the others; a single corner removed always succeeds.
+/// boundary): all-quad always leaves no triangle, by single splits exactly where the oracle
+/// finds a split for every component that keeps a triangle, with sheets otherwise; a single
+/// corner removed never needs sheets.
 #[test]
 fn all_quad_on_lattices_with_triangles_removed_agrees_with_the_oracle() {
-    let (mut ok, mut cases) = (0, 0);
+    let (mut sheets, mut cases) = (0, 0);
     let mut written = Written::new();
     for seed in 0..3u64 {
         let full = lattice(400 + 60 * seed as usize, seed);
@@ -342,26 +339,31 @@ fn all_quad_on_lattices_with_triangles_removed_agrees_with_the_oracle() {
         ] {
             let mesh = without(&full, &drop);
             let what = format!("seed {seed}, drop {drop:?}");
-            let done = agrees_with_oracle(&mesh, seed, &what, &mut written);
+            let used_sheets = agrees_with_oracle(&mesh, seed, &what, &mut written);
             if drop.len() == 1 && c.contains(&drop[0]) {
-                assert!(done, "seed {seed}: one corner removed");
+                assert!(!used_sheets, "seed {seed}: one corner removed");
             }
-            ok += done as usize;
+            sheets += used_sheets as usize;
             cases += 1;
         }
     }
     assert_eq!(cases, 21);
-    assert!(ok >= 8, "{ok} of {cases} succeeded");
-    // Every success written and checked by meshio (0: meshio missing outside CI).
+    // Both ways are exercised (docs/finish.md: 2 of the 21 need sheets).
+    assert!(
+        sheets >= 1 && cases - sheets >= 8,
+        "{sheets} of {cases} needed sheets"
+    );
+    // Every result written and checked by meshio (None: meshio missing outside CI).
     let n = written.check();
-    assert!(n.is_none_or(|n| n == ok), "{n:?} checked of {ok}");
+    assert!(n.is_none_or(|n| n == cases), "{n:?} checked of {cases}");
 }
 
 /// Property over seeds: small jittered lattices and grids with random triangles removed;
-/// all-quad agrees with the brute-force oracle on each.
+/// all-quad leaves no triangle on each (checked from the written files), with sheets exactly
+/// where the brute-force oracle finds no single split for some component.
 #[test]
-fn all_quad_succeeds_exactly_where_a_split_can_fix_every_component() {
-    let (mut ok, mut cases) = (0, 0);
+fn all_quad_leaves_no_triangle_on_random_meshes_with_sheets_where_no_split_fixes() {
+    let (mut sheets, mut cases) = (0, 0);
     let mut written = Written::new();
     for seed in 0..24u64 {
         let mut rng = ChaCha8Rng::seed_from_u64(crate::util::SEED ^ seed);
@@ -381,19 +383,24 @@ fn all_quad_succeeds_exactly_where_a_split_can_fix_every_component() {
         drop.sort_unstable();
         drop.dedup();
         let mesh = without(&base, &drop);
-        ok += agrees_with_oracle(&mesh, seed, &format!("seed {seed}"), &mut written) as usize;
+        sheets += agrees_with_oracle(&mesh, seed, &format!("seed {seed}"), &mut written) as usize;
         cases += 1;
     }
-    // Both outcomes are exercised (random holes often leave an imbalance no split mends).
-    assert!(ok >= 4 && cases - ok >= 4, "{ok} of {cases} succeeded");
+    // Both ways are exercised (random holes often leave an imbalance no split mends: 19 of
+    // the 24 were refused before sheet refinement).
+    assert!(
+        sheets >= 4 && cases - sheets >= 4,
+        "{sheets} of {cases} needed sheets"
+    );
     let n = written.check();
-    assert!(n.is_none_or(|n| n == ok), "{n:?} checked of {ok}");
+    assert!(n.is_none_or(|n| n == cases), "{n:?} checked of {cases}");
 }
 
 /// A component no split can fix: a lone triangle (every side boundary) beside a lattice.
-/// The error names its element and says why.
+/// Sheet refinement makes it 3 quads (3 sheets, each to the boundary at once: 3 midpoints and
+/// the centroid); the lattice is untouched.
 #[test]
-fn all_quad_names_a_component_no_split_can_fix() {
+fn all_quad_refines_a_lone_triangle_into_three_quads() {
     let base = lattice(200, 1);
     let mut vertices = base.vertices.clone();
     let mut triangles = base.triangles.clone();
@@ -401,20 +408,62 @@ fn all_quad_names_a_component_no_split_can_fix() {
     vertices.extend([[50.0, 0.0, 0.0], [51.0, 0.0, 0.0], [50.5, 0.8, 0.0]]);
     triangles.push([v, v + 1, v + 2]);
     let mesh = compact(&vertices, triangles);
-    let lone_id = mesh.triangle_ids[mesh.num_triangles() - 1];
-    match all_quad(&mesh, 0) {
-        Err(FinishError::NotAllQuad(stuck)) => {
-            assert_eq!(stuck.len(), 1, "{stuck:?}");
-            assert_eq!(stuck[0].element, lone_id);
-            assert_eq!(stuck[0].size, 1);
-            assert_eq!(stuck[0].reason, StuckReason::NoSplittableSide);
-            let text = FinishError::NotAllQuad(stuck).to_string();
+    let mut written = Written::new();
+    let f = all_quad_into(&mesh, 0, Some(&mut written)).unwrap();
+    assert!(f.splits.is_empty());
+    assert_eq!(
+        f.sheets,
+        SheetStats {
+            sheets: 3,
+            nodes: 4,
+            triangles_replaced: 1,
+            triangles_added: 5,
+        }
+    );
+    let m = f.mesh(&mesh);
+    // The centroid, and the three midpoints.
+    let at = |p: [f64; 3]| {
+        m.vertices
+            .iter()
+            .any(|q| (0..3).all(|d| (q[d] - p[d]).abs() < 1e-12))
+    };
+    assert!(at([50.5, 0.8 / 3.0, 0.0]));
+    assert!(at([50.5, 0.0, 0.0]) && at([50.75, 0.4, 0.0]) && at([50.25, 0.4, 0.0]));
+    assert!(matches!(written.check(), None | Some(1)));
+}
+
+/// A sheet that reaches a side shared with an input quad cannot go on conformingly: a clear
+/// error naming the element and the side, nothing half made.
+#[test]
+fn all_quad_sheet_stops_with_an_error_at_an_input_quad() {
+    let mesh = Mesh::new(MeshData {
+        vertices: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.5, 0.8, 0.0],
+            [0.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+        ],
+        triangles: vec![[0, 1, 2]],
+        quads: vec![[0, 3, 4, 1]],
+        ..MeshData::default()
+    })
+    .unwrap();
+    let tri_id = mesh.triangle_ids[0];
+    let table = valid_table(&mesh);
+    let config = FinishConfig {
+        all_quad: true,
+        ..FinishConfig::default()
+    };
+    match finish(&mesh, &table, &[], config) {
+        Err(e @ FinishError::Sheet(SheetError::Blocked { .. })) => {
+            let text = e.to_string();
             assert!(
-                text.contains(&format!("element {lone_id}")) && text.contains("boundary side"),
+                text.contains(&format!("element {tri_id}")) && text.contains("input quad"),
                 "{text}"
             );
         }
-        other => panic!("expected NotAllQuad, got {other:?}"),
+        other => panic!("expected a blocked sheet, got {other:?}"),
     }
 }
 
@@ -427,14 +476,40 @@ pub(crate) fn write_input(mesh: &Mesh, path: &Path) {
     quadrecomb::internals::mesh::msh::write(path, mesh, &rec).unwrap();
 }
 
-/// Runs `all_quad_check.py` on `input` and `output`; asserts what it reports and returns
-/// the number of new nodes.
-pub(crate) fn check_written(input: &Path, output: &Path) -> usize {
+/// What `all_quad_check.py` found in one written file, beside what it asserts always (no
+/// triangle, every quad strictly convex, conforming, every new node on the boundary inside an
+/// input boundary side, area kept).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Checked {
+    /// Nodes not in the input.
+    pub new_nodes: usize,
+    /// Of those, the ones on the output's boundary (each inside an input boundary side).
+    pub new_boundary_nodes: usize,
+    /// Triangles the output's quads stand for beyond the input's: `2 x quads - input
+    /// triangles` (input quads aside): one per split, and the sheets' added triangles.
+    pub triangles_added: usize,
+}
+
+impl Checked {
+    /// What a finish that only split boundary sides writes: one node per split, on an input
+    /// boundary side, one triangle more per split.
+    pub fn of_splits(splits: usize) -> Checked {
+        Checked {
+            new_nodes: splits,
+            new_boundary_nodes: splits,
+            triangles_added: splits,
+        }
+    }
+}
+
+/// Runs `all_quad_check.py` on `input` and `output`; asserts what it always must hold and
+/// returns the rest.
+pub(crate) fn check_written(input: &Path, output: &Path) -> Checked {
     check_written_all(&[(input.to_path_buf(), output.to_path_buf())])[0]
 }
 
 /// [`check_written`] for many pairs, in one Python process.
-fn check_written_all(pairs: &[(PathBuf, PathBuf)]) -> Vec<usize> {
+fn check_written_all(pairs: &[(PathBuf, PathBuf)]) -> Vec<Checked> {
     let script = include_str!("all_quad_check.py");
     let args: Vec<&Path> = pairs
         .iter()
@@ -452,16 +527,22 @@ fn check_written_all(pairs: &[(PathBuf, PathBuf)]) -> Vec<usize> {
             let what = format!("{}: {v}", output.display());
             assert_eq!(v["triangles"], 0, "{what}");
             assert_eq!(v["nonconvex"], 0, "{what}");
-            assert_eq!(v["new_nodes_off_boundary_side"], 0, "{what}");
+            assert_eq!(v["new_boundary_nodes_off_boundary_side"], 0, "{what}");
             assert_eq!(v["edges_over_two"], 0, "{what}");
             assert_eq!(v["hanging_edges"], 0, "{what}");
             let new = v["new_nodes"].as_u64().unwrap();
+            let new_boundary = v["new_boundary_nodes"].as_u64().unwrap();
+            // Inner new nodes are exactly those off every input boundary side.
+            assert_eq!(
+                v["new_nodes_off_boundary_side"].as_u64().unwrap(),
+                new - new_boundary,
+                "{what}"
+            );
             let (tin, qin, q) = (
                 v["input_triangles"].as_u64().unwrap(),
                 v["input_quads"].as_u64().unwrap(),
                 v["quads"].as_u64().unwrap(),
             );
-            assert_eq!(2 * (q - qin), tin + new, "{what}");
             let (a, b) = (
                 v["area_in"].as_f64().unwrap(),
                 v["area_out"].as_f64().unwrap(),
@@ -470,7 +551,11 @@ fn check_written_all(pairs: &[(PathBuf, PathBuf)]) -> Vec<usize> {
             // surfaces.
             let tol = if v["planar"] == true { 1e-9 } else { 1e-3 };
             assert!((a - b).abs() <= tol * a.max(1.0), "{what}");
-            new as usize
+            Checked {
+                new_nodes: new as usize,
+                new_boundary_nodes: new_boundary as usize,
+                triangles_added: (2 * (q - qin) - tin) as usize,
+            }
         })
         .collect()
 }
@@ -480,7 +565,7 @@ fn check_written_all(pairs: &[(PathBuf, PathBuf)]) -> Vec<usize> {
 struct Written {
     dir: tempfile::TempDir,
     pairs: Vec<(PathBuf, PathBuf)>,
-    splits: Vec<usize>,
+    expected: Vec<Checked>,
 }
 
 impl Written {
@@ -488,7 +573,7 @@ impl Written {
         Written {
             dir: tempfile::tempdir().unwrap(),
             pairs: Vec::new(),
-            splits: Vec::new(),
+            expected: Vec::new(),
         }
     }
 
@@ -502,7 +587,7 @@ impl Written {
         let rec = quality::recombined(f.mesh(input), f.table(table), &f.chosen);
         quadrecomb::internals::mesh::msh::write(&b, f.mesh(input), &rec).unwrap();
         self.pairs.push((a, b));
-        self.splits.push(f.splits.len());
+        self.expected.push(expected(f));
     }
 
     /// Checks every file written; returns how many (`None` without meshio, outside CI).
@@ -513,9 +598,26 @@ impl Written {
         if self.pairs.is_empty() {
             return Some(0);
         }
-        let new = check_written_all(&self.pairs);
-        assert_eq!(new, self.splits, "one new node per split");
-        Some(new.len())
+        let found = check_written_all(&self.pairs);
+        assert_eq!(found.len(), self.expected.len());
+        for (f, e) in found.iter().zip(&self.expected) {
+            assert_eq!(
+                f.new_nodes, e.new_nodes,
+                "one node per split, the sheets' nodes"
+            );
+            assert_eq!(f.triangles_added, e.triangles_added);
+            // Splits only: every new node on the boundary. With sheets, the splits' nodes
+            // and the ends of sheets that reach the boundary.
+            if e.new_nodes == e.new_boundary_nodes {
+                assert_eq!(f.new_boundary_nodes, e.new_boundary_nodes, "splits only");
+            } else {
+                assert!(
+                    f.new_boundary_nodes >= e.new_boundary_nodes,
+                    "{f:?} vs {e:?}"
+                );
+            }
+        }
+        Some(found.len())
     }
 }
 
@@ -554,34 +656,35 @@ fn cli_all_quad_files_of_lattices_without_corners_check_out_in_meshio() {
             );
             let text = String::from_utf8_lossy(&run.stdout);
             assert!(text.contains("on the chord"), "{text}");
-            let new = check_written(&input, &dir.path().join(&out));
+            let found = check_written(&input, &dir.path().join(&out));
             assert_eq!(
-                new,
-                odd_components(&mesh),
+                found,
+                Checked::of_splits(odd_components(&mesh)),
                 "{name}: one node per odd component"
             );
         }
     }
 }
 
-/// The suite's meshes with odd components: where every odd component has a boundary
-/// triangle whose split keeps the rest matchable (vase-revolution, many-holes),
-/// `recombine --finish --all-quad` leaves no triangle, as meshio reads the file; where one
-/// has none (odd-pieces: proven by the oracle below; capped-cylinder and materials: odd
-/// components with no boundary side at all, only sides shared with another surface) it
-/// fails with exit code 3 and names the components.
+/// The suite's meshes with odd components: `recombine --finish --all-quad` leaves no
+/// triangle on each, as meshio reads the file (strictly convex, conforming, new boundary nodes
+/// on input boundary sides, area kept). Where every odd component has a boundary triangle
+/// whose split keeps the rest matchable (vase-revolution, many-holes) by single splits only;
+/// where one has none (odd-pieces: proven by the oracle below; capped-cylinder and materials:
+/// odd components with no boundary side at all, only sides shared with another surface) by
+/// sheet refinement there (these three were refused with exit code 3 before).
 #[test]
 fn cli_all_quad_on_the_suite_meshes_with_odd_components() {
     if !python_module_available("meshio") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    for (name, works) in [
-        ("vase-revolution", true),
-        ("many-holes", true),
-        ("odd-pieces", false),
-        ("capped-cylinder", false),
-        ("materials", false),
+    for (name, needs_sheets) in [
+        ("vase-revolution", false),
+        ("many-holes", false),
+        ("odd-pieces", true),
+        ("capped-cylinder", true),
+        ("materials", true),
     ] {
         let input = crate::util::repo_path(&format!("meshes/suite/{name}.msh"));
         let out = dir.path().join(format!("{name}-aq.msh"));
@@ -601,46 +704,51 @@ fn cli_all_quad_on_the_suite_meshes_with_odd_components() {
             ],
         );
         let err = String::from_utf8_lossy(&run.stderr);
-        if !works {
-            assert_eq!(run.status.code(), Some(3), "{name}: {err}");
-            assert!(
-                err.contains("all-quad cannot pair every triangle") && err.contains("element"),
-                "{name}: {err}"
-            );
-            assert!(!out.exists());
-            continue;
-        }
         assert!(run.status.success(), "{name}: {err}");
         let v: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
-        assert_eq!(v["finish"]["triangles_left"], 0, "{name}: {v}");
-        let splits = v["finish"]["splits"].as_array().unwrap().len();
-        assert!(splits >= 1, "{name}: {v}");
-        assert_eq!(v["finish"]["split_place"], "chord");
-        assert_eq!(check_written(&input, &out), splits, "{name}");
+        let f = &v["finish"];
+        assert_eq!(f["triangles_left"], 0, "{name}: {v}");
+        let splits = f["splits"].as_array().unwrap().len();
+        let found = check_written(&input, &out);
+        if !needs_sheets {
+            assert!(splits >= 1, "{name}: {v}");
+            assert_eq!(f["split_place"], "chord");
+            assert!(f["sheets"].is_null(), "{name}: {v}");
+            assert_eq!(found, Checked::of_splits(splits), "{name}");
+            continue;
+        }
+        let s = &f["sheets"];
+        assert!(s["sheets"].as_u64().unwrap() >= 1, "{name}: {v}");
+        let (nodes, added) = (
+            s["nodes_added"].as_u64().unwrap() as usize,
+            s["triangles_added"].as_u64().unwrap() as usize,
+        );
+        assert_eq!(found.new_nodes, splits + nodes, "{name}: {v}");
+        assert_eq!(found.triangles_added, splits + added, "{name}: {v}");
+        assert!(found.new_boundary_nodes >= splits, "{name}: {v}");
     }
 }
 
-/// odd-pieces: the components all-quad refuses are those where no single boundary split
-/// works, by brute force over every boundary side.
+/// odd-pieces: all-quad needs sheets there, because the oracle proves some component has no
+/// single boundary split that works (brute force over every boundary side); the result leaves
+/// no triangle, checked from the written file.
 #[test]
-fn all_quad_refuses_on_odd_pieces_only_what_the_oracle_cannot_fix() {
+fn all_quad_needs_sheets_on_odd_pieces_where_the_oracle_finds_no_split() {
     let mesh = quadrecomb::internals::mesh::load(
         crate::util::repo_path("meshes/suite/odd-pieces.msh")
             .to_str()
             .unwrap(),
     )
     .unwrap();
-    assert!(!agrees_with_oracle(
-        &mesh,
-        0,
-        "odd-pieces",
-        &mut Written::new()
-    ));
+    let mut written = Written::new();
+    assert!(agrees_with_oracle(&mesh, 0, "odd-pieces", &mut written));
+    assert!(matches!(written.check(), None | Some(1)));
 }
 
-/// A mesh no split can fix: the command fails with exit code 3 and names the element.
+/// A mesh no split can fix (a lone triangle beside a lattice): the command refines it by
+/// sheets and writes only quads, as meshio reads the file.
 #[test]
-fn cli_all_quad_refuses_a_mesh_no_split_can_fix() {
+fn cli_all_quad_refines_a_mesh_no_split_can_fix() {
     let dir = tempfile::tempdir().unwrap();
     let base = lattice(200, 1);
     let mut vertices = base.vertices.clone();
@@ -649,7 +757,6 @@ fn cli_all_quad_refuses_a_mesh_no_split_can_fix() {
     vertices.extend([[50.0, 0.0, 0.0], [51.0, 0.0, 0.0], [50.5, 0.8, 0.0]]);
     triangles.push([v, v + 1, v + 2]);
     let mesh = compact(&vertices, triangles);
-    let id = mesh.triangle_ids[mesh.num_triangles() - 1];
     write_input(&mesh, &dir.path().join("lone.msh"));
     let run = run_in(
         dir.path(),
@@ -664,11 +771,17 @@ fn cli_all_quad_refuses_a_mesh_no_split_can_fix() {
             "x.msh",
         ],
     );
-    assert_eq!(run.status.code(), Some(3));
     let err = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{err}");
+    let text = String::from_utf8_lossy(&run.stdout);
     assert!(
-        err.contains("lone.msh") && err.contains(&format!("element {id}")),
-        "{err}"
+        text.contains("sheets        3 sheets") && text.contains("4 nodes added"),
+        "{text}"
     );
-    assert!(!dir.path().join("x.msh").exists());
+    if python_module_available("meshio") {
+        let found = check_written(&dir.path().join("lone.msh"), &dir.path().join("x.msh"));
+        assert_eq!(found.new_nodes, 4);
+        assert_eq!(found.new_boundary_nodes, 3);
+        assert_eq!(found.triangles_added, 5);
+    }
 }

@@ -1,7 +1,8 @@
 # Checks an all-quad output against its input, both read by meshio (not by quadrecomb):
 # no triangle; every quad strictly convex (cross products of consecutive sides, against the
 # quad's Newell normal, all positive); every node not in the input lies strictly inside one
-# boundary side of the input (a side used by one input element) on its chord; conformity:
+# boundary side of the input (a side used by one input element) on its chord (with sheet
+# refinement: every new node on the output's boundary does, the others are inner); conformity:
 # every edge is used by one or two quads, and an edge used by one lies on an input boundary
 # side; the quads cover the input's area. Prints one JSON object.
 # Usage: python3 all_quad_check.py INPUT.msh OUTPUT.(msh|vtu) [INPUT OUTPUT ...]: one line
@@ -100,6 +101,11 @@ def check(inp, out):
 
 
     hanging = sum(1 for (a, b), n in use.items() if n == 1 and not on_input_boundary(a, b))
+    # New nodes on the output's boundary (an edge used once) must lie inside an input
+    # boundary side; the others are inner nodes (sheet refinement's midpoints and centres).
+    on_out_boundary = set(v for (a, b), n in use.items() if n == 1 for v in (a, b))
+    new_boundary = [i for i in new_nodes if i in on_out_boundary]
+    new_boundary_off = [i for i in new_boundary if on_boundary_side(P[i]) < 0]
 
 
     def area(c):
@@ -118,6 +124,8 @@ def check(inp, out):
         "input_quads": len(quad_in),
         "new_nodes": len(new_nodes),
         "new_nodes_off_boundary_side": len(off_side),
+        "new_boundary_nodes": len(new_boundary),
+        "new_boundary_nodes_off_boundary_side": len(new_boundary_off),
         "nonconvex": nonconvex,
         "edges_over_two": over,
         "hanging_edges": hanging,

@@ -3,7 +3,7 @@
 //! rebuilds the split mesh from the record and `-o` writes the finished mesh, as meshio reads
 //! it; other all-quad settings are refused on resume.
 
-use crate::all_quad::{check_written, without, write_input};
+use crate::all_quad::{Checked, check_written, without, write_input};
 use crate::runner::{records, stderr, sweep};
 use crate::util::{SEED, python, python_module_available, run_in};
 use quadrecomb::internals::experiment::manifest::Manifest;
@@ -108,7 +108,10 @@ fn sweep_finish_all_quad_records_splits_and_replay_writes_the_finished_mesh() {
     assert_eq!(v["finish"]["all_quad"]["splits"], 1);
     assert_eq!(v["finish"]["quads"], v["recorded"]["finish"]["quads"]);
     if python_module_available("meshio") {
-        assert_eq!(check_written(&dir.join("one.msh"), &dir.join("r.msh")), 1);
+        assert_eq!(
+            check_written(&dir.join("one.msh"), &dir.join("r.msh")),
+            Checked::of_splits(1)
+        );
     }
 
     // Without --all-quad the settings differ: resume refuses.
@@ -149,5 +152,70 @@ fn sweep_finish_all_quad_records_splits_and_replay_writes_the_finished_mesh() {
     assert!(out.status.success(), "{}", stderr(&out));
     if python_module_available("meshio") {
         assert_eq!(triangles_in(&dir.join("f.vtu")), 1);
+    }
+}
+
+/// A mesh no single split fixes (a lone triangle beside a lattice): `sweep --finish
+/// --all-quad` finishes every run by sheet refinement, the records say so additively
+/// (`sheets`, `sheet_nodes`, ... within `finish.all_quad`), and replay reproduces the run and
+/// writes the refined mesh, as meshio reads it.
+#[test]
+fn sweep_finish_all_quad_with_sheets_records_them_and_replay_reproduces() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let base = lattice(200, 1);
+    let mut vertices = base.vertices.clone();
+    let mut triangles = base.triangles.clone();
+    let v = vertices.len() as u32;
+    vertices.extend([[50.0, 0.0, 0.0], [51.0, 0.0, 0.0], [50.5, 0.8, 0.0]]);
+    triangles.push([v, v + 1, v + 2]);
+    let mesh = crate::all_quad::compact(&vertices, triangles);
+    write_input(&mesh, &dir.join("one.msh"));
+    let out = sweep(dir, &args("aq", &["--finish", "--all-quad"]), &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let recs = records(&dir.join("aq"));
+    let mut finished = 0;
+    for r in &recs {
+        if r.algo == "optimum" {
+            continue;
+        }
+        let f = r.finish.as_ref().unwrap();
+        let a = f.all_quad.expect("all-quad figures in the record");
+        assert_eq!(a.splits, 0, "{}", r.key());
+        assert_eq!((a.sheets, a.sheet_nodes, a.nodes_added), (3, 4, 4));
+        assert_eq!(
+            (a.sheet_triangles_replaced, a.sheet_triangles_added),
+            (1, 5)
+        );
+        assert_eq!(f.triangles_left, 0);
+        assert_eq!(2 * f.quads, r.triangles + 5);
+        finished += 1;
+    }
+    assert_eq!(finished, 2);
+    let text = std::fs::read_to_string(dir.join("aq/runs.jsonl")).unwrap();
+    assert!(
+        text.contains("\"sheets\":3,\"sheet_nodes\":4,\"sheet_triangles_replaced\":1,\"sheet_triangles_added\":5"),
+        "{text}"
+    );
+    let out = run_in(
+        dir,
+        &[
+            "replay",
+            "aq",
+            "1",
+            "--algo",
+            "selective",
+            "--json",
+            "-o",
+            "r.msh",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["reproduced"], true, "{v}");
+    assert_eq!(v["finish"]["all_quad"]["sheets"], 3, "{v}");
+    if python_module_available("meshio") {
+        let found = check_written(&dir.join("one.msh"), &dir.join("r.msh"));
+        assert_eq!((found.new_nodes, found.triangles_added), (4, 5));
     }
 }
