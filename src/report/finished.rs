@@ -8,6 +8,45 @@ use super::{Config, Document, Run};
 use crate::experiment::summary::Summary;
 use crate::stats::describe::median;
 
+/// Whether some finished run of `runs` was refined by sheets (`--all-quad`): its mesh has more
+/// quads than the input's triangles allow, so its quality is not comparable to the input's
+/// optimum (it can exceed 100 %).
+fn refined(runs: &[Run]) -> bool {
+    (runs.iter()).any(|r| {
+        r.finish
+            .as_ref()
+            .and_then(|f| f.all_quad.as_ref())
+            .is_some_and(|a| a.sheets > 0)
+    })
+}
+
+/// A quality percentage, marked with a dagger when the runs were refined by sheets.
+fn pct(v: Option<f64>, refined: bool) -> String {
+    let s = fmt_opt(v, 2);
+    if refined && v.is_some() {
+        format!("{s} †")
+    } else {
+        s
+    }
+}
+
+/// The note under a table whose rows carry a dagger.
+const REFINED_NOTE: &str = "† Some runs were refined by sheets (--all-quad, where no single \
+    boundary split could make a component even; docs/finish.md): their finished mesh has more \
+    quads than the input's triangles allow, so its quality is not comparable to the input's \
+    optimum (it can exceed 100 %). Compare their mean eta per quad instead (runs.jsonl, \
+    finish.mean_eta).";
+
+/// Whether any finished configuration of `configs` was refined by sheets.
+pub(super) fn any_refined(configs: &[(&Config, &[Run])]) -> bool {
+    configs.iter().any(|(_, runs)| refined(runs))
+}
+
+/// The note to print under the results table when [`any_refined`].
+pub(super) fn refined_note() -> &'static str {
+    REFINED_NOTE
+}
+
 /// The results-table rows of the finished runs (same columns as the raw rows: algorithm,
 /// horizon, runs, quality %, recombined %, time, nodes per tree, branching factor); time is
 /// the search's and the finish's together, and the tree columns are "–".
@@ -30,7 +69,7 @@ pub(super) fn table_rows(summary: &Summary, configs: &[(&Config, &[Run])]) -> Ve
             },
             c.horizon.map_or("–".into(), |h| h.to_string()),
             g.n.to_string(),
-            fmt_opt(whole(g.quality_pct.as_ref()), 2),
+            pct(whole(g.quality_pct.as_ref()), refined(runs)),
             fmt_opt(whole(g.recombined_pct.as_ref()), 2),
             if total.is_empty() {
                 "–".into()
@@ -73,8 +112,11 @@ pub(super) fn what_it_added(doc: &mut Document, summary: &Summary, configs: &[(&
             c.horizon.map_or("–".into(), |h| h.to_string()),
             g.n.to_string(),
             fmt_opt(median_of(summary, c, |g| g.quality_pct.as_ref()), 2),
-            fmt_opt(whole(g.quality_pct.as_ref()), 2),
-            fmt_opt((gain.len() == pairs.len()).then(|| median(&gain)), 2),
+            pct(whole(g.quality_pct.as_ref()), refined(runs)),
+            pct(
+                (gain.len() == pairs.len()).then(|| median(&gain)),
+                refined(runs),
+            ),
             fmt_opt(median_of(summary, c, |g| g.recombined_pct.as_ref()), 2),
             fmt_opt(whole(g.recombined_pct.as_ref()), 2),
             fmt_sig(median(&left), 3),
@@ -109,4 +151,7 @@ pub(super) fn what_it_added(doc: &mut Document, summary: &Summary, configs: &[(&
          quality minus its raw quality, in points of the optimum; the finish time is the \
          finish's alone (the \"+ finish\" rows of the results table count the search's too)."
     ));
+    if any_refined(configs) {
+        doc.para(REFINED_NOTE);
+    }
 }

@@ -121,6 +121,9 @@ pub(super) fn mesh_section(
          decisions are unchanged), and its time grows more slowly with the horizon.",
     );
 
+    if super::finished::any_refined(&configs) {
+        doc.para(super::finished::refined_note());
+    }
     super::finished::what_it_added(doc, summary, &configs);
     element_table(doc, summary, &configs);
     greedy_paradox(doc, &configs);

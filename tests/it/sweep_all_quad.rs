@@ -84,6 +84,10 @@ fn sweep_finish_all_quad_records_splits_and_replay_writes_the_finished_mesh() {
     );
     let report = std::fs::read_to_string(dir.join("aq/report.md")).unwrap();
     assert!(
+        !report.contains('†'),
+        "no run was refined by sheets: {report}"
+    );
+    assert!(
         report.contains("| selective + finish | 1 | 2 | "),
         "{report}"
     );
@@ -192,6 +196,17 @@ fn sweep_finish_all_quad_with_sheets_records_them_and_replay_reproduces() {
         finished += 1;
     }
     assert_eq!(finished, 2);
+    // The refined mesh has more quads than the input allows: the report marks its quality %
+    // (not comparable to the input's optimum) and says why.
+    let report = std::fs::read_to_string(dir.join("aq/report.md")).unwrap();
+    assert!(
+        report.contains("| selective + finish | 1 | 2 |") && report.contains(" † |"),
+        "{report}"
+    );
+    assert!(
+        report.contains("† Some runs were refined by sheets"),
+        "{report}"
+    );
     let text = std::fs::read_to_string(dir.join("aq/runs.jsonl")).unwrap();
     assert!(
         text.contains("\"sheets\":3,\"sheet_nodes\":4,\"sheet_triangles_replaced\":1,\"sheet_triangles_added\":5"),
