@@ -181,8 +181,9 @@ pub fn plan(spec: &SweepSpec) -> Vec<Job> {
 
 /// The runs of `algo` on mesh `m` at each of the spec's time budgets, with the knob its
 /// calibration chose (a time budget not calibrated yet has no runs). A time budget enters the
-/// seed as part of the name ("mcts t=0.2"), not the knob chosen: the runs of a time budget
-/// have the same seeds on any machine.
+/// seed as part of the name ("mcts t=0.2"); the node budget chosen does not, so the runs of
+/// optimistic, mcts and beam at a time budget have the same seeds on any machine, but the
+/// horizon chosen for selective and uniform does (it is the seed's horizon).
 fn timed_jobs(spec: &SweepSpec, m: usize, algo: &str, runs: u32, jobs: &mut Vec<Job>) {
     let mesh = &spec.meshes[m];
     let horizons: Vec<Option<u32>> = if has_budget(algo) {

@@ -63,7 +63,7 @@ impl<'r> Medians<'r> {
         for mesh in &results.meshes {
             let row: Vec<Option<Cell>> = (methods.iter())
                 .map(|m| {
-                    let runs = results.get(mesh, &m.algo, m.horizon)?;
+                    let runs = results.get_on(mesh, m)?;
                     let c = Config::of(&runs[0]);
                     let median = median_of(summary, &c, |g| g.quality_pct.as_ref())?;
                     Some(Cell {
@@ -219,10 +219,8 @@ fn record(results: &Results, m: &Medians<'_>, j: usize, base: usize, seed: u64) 
     // (the runs against the single value, as the per-mesh comparisons with greedy do).
     let mut swapped: Vec<&str> = Vec::new();
     for mesh in &m.meshes {
-        let (Some(x), Some(y)) = (
-            results.get(mesh, &method.algo, method.horizon),
-            results.get(mesh, &baseline.algo, baseline.horizon),
-        ) else {
+        let (Some(x), Some(y)) = (results.get_on(mesh, method), results.get_on(mesh, baseline))
+        else {
             continue;
         };
         if x.len() == 1 && y.len() > 1 {

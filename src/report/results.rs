@@ -167,11 +167,18 @@ impl Results {
             .map(|(c, r)| (c, r.as_slice()))
     }
 
-    /// The runs of a configuration, if present.
-    pub fn get(&self, mesh: &str, algo: &str, horizon: Option<u32>) -> Option<&[Run]> {
+    /// The runs of `method` (a configuration whatever its mesh: algorithm, horizon, node
+    /// budget and time budget) on `mesh`, if present.
+    pub fn get_on(&self, mesh: &str, method: &Config) -> Option<&[Run]> {
         self.groups
             .iter()
-            .find(|(c, _)| c.mesh == mesh && c.algo == algo && c.horizon == horizon)
+            .find(|(c, _)| {
+                c.mesh == mesh
+                    && c.algo == method.algo
+                    && c.horizon == method.horizon
+                    && c.budget == method.budget
+                    && c.time_budget == method.time_budget
+            })
             .map(|(_, r)| r.as_slice())
     }
 

@@ -303,3 +303,38 @@ fn the_deepest_horizon_is_asked_about_too_when_it_is_not_the_best() {
     );
     assert!(deepest.contains("not on c (tie: "), "{deepest}");
 }
+
+#[test]
+fn each_node_budget_keeps_its_own_runs_across_meshes() {
+    // Two meshes, mcts h=3 at budgets 2 and 32 far apart in quality: the section and
+    // across_meshes.csv took the first budget's runs for every budget (the lookup ignored the
+    // budget), so b=32 showed b=2's medians and the two tied.
+    let tmp = tempfile::tempdir().unwrap();
+    let mut lines = Vec::new();
+    for (i, mesh) in ["a", "b"].iter().enumerate() {
+        for run in 0..5 {
+            let base = 90.0 + i as f64 + f64::from(run) * 0.1;
+            lines.push(record(mesh, "selective", Some(3), run, base, 95.0, 0.05));
+            for (budget, q) in [(2u32, base - 10.0), (32, base + 2.0)] {
+                let mut r: serde_json::Value =
+                    serde_json::from_str(&record(mesh, "mcts", Some(3), run, q, 95.0, 0.05))
+                        .unwrap();
+                r["budget"] = budget.into();
+                lines.push(r.to_string());
+            }
+        }
+    }
+    std::fs::write(tmp.path().join("runs.jsonl"), lines.join("\n") + "\n").unwrap();
+    let paths = report::write(tmp.path(), &opts()).unwrap();
+    let csv =
+        std::fs::read_to_string(paths.across_csv.expect("across_meshes.csv written")).unwrap();
+    for (i, mesh) in ["a", "b"].iter().enumerate() {
+        for (label, q) in [("mcts h=3 b=2", 80.2), ("mcts h=3 b=32", 92.2)] {
+            let line = (csv.lines())
+                .find(|l| l.starts_with(&format!("{mesh},")) && l.contains(&format!(",{label},")))
+                .unwrap_or_else(|| panic!("no {mesh} {label} in\n{csv}"));
+            let median: f64 = line.split(',').nth(6).unwrap().parse().unwrap();
+            assert!((median - (q + i as f64)).abs() < 1e-9, "{line}\n{csv}");
+        }
+    }
+}
