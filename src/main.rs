@@ -3,6 +3,7 @@
 
 mod cli;
 
+use std::io::Write as _;
 use std::process::ExitCode;
 
 /// Out of memory is an error with a message and exit code 5, not an abort.
@@ -14,7 +15,8 @@ fn main() -> ExitCode {
     match cli::run() {
         Ok(code) => code,
         Err(err) => {
-            eprintln!("error: {}", cli::describe(&err));
+            // A closed stderr must not turn the error into a panic: the exit code says it.
+            let _ = writeln!(std::io::stderr(), "error: {}", cli::describe(&err));
             ExitCode::from(cli::exit_code(&err))
         }
     }

@@ -53,15 +53,18 @@ pub fn json(
 
 fn line(name: &str, s: &StepFigures, pct: impl Fn(f64) -> Option<f64>) {
     let p = pct(s.quality).map_or(String::new(), |p| format!(", {p:.2} % of the optimum"));
-    println!(
+    outln!(
         "  {name:<13} {} quads, {} triangles left, quality {:.4}{p}, {:.4} s",
-        s.quads, s.triangles_left, s.quality, s.time_s
+        s.quads,
+        s.triangles_left,
+        s.quality,
+        s.time_s
     );
 }
 
 /// The text lines of `recombine --finish`.
 pub fn print(f: &Finished, table: &CandidateTable, pct: impl Fn(f64) -> Option<f64> + Copy) {
-    println!("finish");
+    outln!("finish");
     line("eliminate", &f.eliminated, pct);
     if let Some(s) = &f.all_quad {
         line("all-quad", s, pct);
@@ -69,26 +72,33 @@ pub fn print(f: &Finished, table: &CandidateTable, pct: impl Fn(f64) -> Option<f
     line("improve", &f.improved, pct);
     let elements = ElementQuality::of_chosen(f.table(table), &f.chosen);
     if let Some(w) = elements.worst {
-        println!("  worst eta     {w:.4}");
+        outln!("  worst eta     {w:.4}");
     }
-    println!(
+    outln!(
         "  work          {} regions (up to {} rings), {} windows in {} passes, {} kept",
-        f.stats.regions, f.stats.max_rings, f.stats.windows, f.stats.passes, f.stats.kept
+        f.stats.regions,
+        f.stats.max_rings,
+        f.stats.windows,
+        f.stats.passes,
+        f.stats.kept
     );
     if !f.splits.is_empty() {
-        println!(
+        outln!(
             "  splits        {} boundary sides split, new nodes {SPLIT_PLACE}",
             f.splits.len()
         );
         for s in &f.splits {
-            println!(
+            outln!(
                 "                side {}-{} split by node {} (leftover moved {} steps)",
-                s.side[0], s.side[1], s.node, s.path_len
+                s.side[0],
+                s.side[1],
+                s.node,
+                s.path_len
             );
         }
     }
     if f.sheets.sheets > 0 {
-        println!(
+        outln!(
             "  sheets        {} sheets through the components no split fixes: {} nodes added, {} triangles replaced by {} (as quads: {})",
             f.sheets.sheets,
             f.sheets.nodes,
@@ -97,5 +107,5 @@ pub fn print(f: &Finished, table: &CandidateTable, pct: impl Fn(f64) -> Option<f
             (f.sheets.triangles_replaced + f.sheets.triangles_added) / 2
         );
     }
-    println!("  finish time   {:.4} s", f.time_s());
+    outln!("  finish time   {:.4} s", f.time_s());
 }

@@ -201,10 +201,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "generate_s": generated,
             "write_s": written,
         });
-        println!("{v}");
+        outln!("{v}");
         return Ok(ExitCode::SUCCESS);
     }
-    println!(
+    outln!(
         "wrote {}: {} triangles, {} vertices ({what}); generated in {generated:.3} s, written in {written:.3} s",
         output.display(),
         mesh.num_triangles(),

@@ -27,7 +27,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let start = std::time::Instant::now();
     super::errors::check_results_dir(&args.out)?;
     let merged = merge(&args.dirs, &args.out)?;
-    eprintln!(
+    noteln!(
         "merge: {} runs from {} directories into {}",
         merged.records,
         merged.parts,
@@ -48,7 +48,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 out.display()
             )
         })?;
-        eprintln!("merge: report in {}", paths.markdown.display());
+        noteln!("merge: report in {}", paths.markdown.display());
         report = super::report::paths_json(&paths);
     }
     if args.json {
@@ -60,7 +60,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "report": report,
             "time_s": start.elapsed().as_secs_f64(),
         });
-        println!("{v}");
+        outln!("{v}");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -1,5 +1,24 @@
 //! Subcommands, one module each: `Args` (clap derive) and `run(args)`.
 
+/// `println!` that ignores a closed stdout (`quadrecomb ... | head -1`): a reader that
+/// stopped reading must not turn a finished run into a panic (exit 101) or cut a sweep short
+/// before its report. Defined before the submodules so that they all see it.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+/// `eprintln!` that ignores a closed stderr (`quadrecomb sweep ... 2>&1 | head -1`), for the
+/// same reason as `outln!`: notes and progress are not worth the run.
+macro_rules! noteln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod bench;
 mod completions;
 mod errors;
@@ -119,13 +138,14 @@ pub fn print_element_lines(
     rule: quadrecomb::internals::quality::Rule,
 ) {
     if let (Some(worst), Some(mean)) = (e.worst, e.mean) {
-        println!("quad eta        worst {worst:.4}, mean {mean:.4}");
-        println!(
+        outln!("quad eta        worst {worst:.4}, mean {mean:.4}");
+        outln!(
             "poor quads      {} with eta < 0.1, {} with eta < 0.3",
-            e.below_0_1, e.below_0_3
+            e.below_0_1,
+            e.below_0_3
         );
     }
-    println!("rule            {rule}");
+    outln!("rule            {rule}");
 }
 
 /// `-o` and `--vtu-ascii`: where a command writes its mesh, and how.

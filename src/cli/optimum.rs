@@ -75,24 +75,26 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 "positive_blossoms": r.positive_blossoms,
             });
         }
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!("mesh            {}", args.mesh);
-        println!("triangles       {nt}");
-        println!("quads           {}", opt.quads);
-        println!("triangles left  {}", opt.triangles_left);
-        println!("recombined      {pct:.2} %");
-        println!("quality         {:.6} (sum of eta)", opt.quality);
+        outln!("mesh            {}", args.mesh);
+        outln!("triangles       {nt}");
+        outln!("quads           {}", opt.quads);
+        outln!("triangles left  {}", opt.triangles_left);
+        outln!("recombined      {pct:.2} %");
+        outln!("quality         {:.6} (sum of eta)", opt.quality);
         super::print_element_lines(&elements, rule);
-        println!("time            {:.4} s", opt.time_s);
+        outln!("time            {:.4} s", opt.time_s);
         if let Some(r) = report {
-            println!(
+            outln!(
                 "certificate     ok ({} edges, {} blossoms, {} with positive dual)",
-                r.edges_checked, r.blossoms, r.positive_blossoms
+                r.edges_checked,
+                r.blossoms,
+                r.positive_blossoms
             );
         }
         if let Some(p) = &args.out.output {
-            println!("wrote           {}", p.display());
+            outln!("wrote           {}", p.display());
         }
     }
     Ok(ExitCode::SUCCESS)

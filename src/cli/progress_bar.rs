@@ -90,7 +90,7 @@ pub fn attach(searcher: &mut Searcher<'_>, horizon: Option<u32>) -> ProgressBar 
         if !warned && p.elapsed_s >= ESTIMATE_AFTER_S {
             if let Some(w) = cost_warning(p, horizon) {
                 warned = true;
-                shown.suspend(|| eprintln!("{w}"));
+                shown.suspend(|| noteln!("{w}"));
             }
         }
         if p.elapsed_s < BAR_AFTER_S {

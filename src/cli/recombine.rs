@@ -159,7 +159,7 @@ fn calibrated(
         }
     };
     let flag = if nodes { "--budget" } else { "--horizon" };
-    eprintln!(
+    noteln!(
         "recombine: --time-budget {t} calibrated to {flag} {} (median {:.3} s over {} pilot runs \
          on other seeds; {} values tried){}; to repeat this run give {flag} {} instead",
         choice.knob,
@@ -217,10 +217,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for kind in algo.ignored(given) {
         match kind {
             search::methods::ParamKind::Horizon => {
-                eprintln!("note: --horizon is ignored: {name} looks no further than one action")
+                noteln!("note: --horizon is ignored: {name} looks no further than one action")
             }
             search::methods::ParamKind::Budget => {
-                eprintln!("note: --budget is ignored: {name} has no node budget")
+                noteln!("note: --budget is ignored: {name} has no node budget")
             }
         }
     }
@@ -312,42 +312,44 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         if let Some(f) = &finished {
             v["finish"] = super::finish_report::json(f, &table, pct_of);
         }
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!("mesh            {}", args.mesh);
-        println!("triangles       {nt}");
+        outln!("mesh            {}", args.mesh);
+        outln!("triangles       {nt}");
         match (horizon, algo.budget()) {
-            (Some(h), Some(b)) => println!(
+            (Some(h), Some(b)) => outln!(
                 "algo            {} (horizon {h}, budget {b}, seed {})",
-                algo, args.seed
+                algo,
+                args.seed
             ),
             (Some(h), None) => {
-                println!("algo            {} (horizon {h}, seed {})", algo, args.seed)
+                outln!("algo            {} (horizon {h}, seed {})", algo, args.seed)
             }
-            _ => println!("algo            {} (seed {})", algo, args.seed),
+            _ => outln!("algo            {} (seed {})", algo, args.seed),
         }
-        println!("eta             {backend}");
-        println!("quads           {}", out.quads);
-        println!("triangles left  {}", out.triangles_left);
-        println!("recombined      {recombined_pct:.2} %");
+        outln!("eta             {backend}");
+        outln!("quads           {}", out.quads);
+        outln!("triangles left  {}", out.triangles_left);
+        outln!("recombined      {recombined_pct:.2} %");
         match (quality_pct, &opt) {
-            (Some(p), Some(o)) => println!(
+            (Some(p), Some(o)) => outln!(
                 "quality         {:.4} (sum of eta; {p:.2} % of the optimum {:.4})",
-                out.quality, o.quality
+                out.quality,
+                o.quality
             ),
-            _ => println!("quality         {:.4} (sum of eta)", out.quality),
+            _ => outln!("quality         {:.4} (sum of eta)", out.quality),
         }
         super::print_element_lines(&elements, rule);
         match (nodes_expanded, tree_count) {
-            (Some(n), Some(t)) => println!("nodes expanded  {n} ({t} look-ahead trees)"),
-            _ => println!("nodes expanded  – (no look-ahead tree: {algo} builds none)"),
+            (Some(n), Some(t)) => outln!("nodes expanded  {n} ({t} look-ahead trees)"),
+            _ => outln!("nodes expanded  – (no look-ahead tree: {algo} builds none)"),
         }
-        println!("time            {:.4} s", out.time_s);
+        outln!("time            {:.4} s", out.time_s);
         if let Some(f) = &finished {
             super::finish_report::print(f, &table, pct_of);
         }
         if let Some(p) = &args.out.output {
-            println!("wrote           {}", p.display());
+            outln!("wrote           {}", p.display());
         }
     }
     Ok(ExitCode::SUCCESS)

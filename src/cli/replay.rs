@@ -202,36 +202,39 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         if let Some(b) = record.budget {
             v["budget"] = serde_json::json!(b);
         }
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!("results         {}", args.dir.display());
+        outln!("results         {}", args.dir.display());
         let what = if typical {
             format!(", the typical run (median by quality of {})", runs.len())
         } else {
             String::new()
         };
-        println!(
+        outln!(
             "run             {} (seed {}){what}",
             record.key(),
             record.seed
         );
-        println!("eta             {}", out.eta_note());
-        println!("quads           {} (recorded {})", out.quads, record.quads);
-        println!(
+        outln!("eta             {}", out.eta_note());
+        outln!("quads           {} (recorded {})", out.quads, record.quads);
+        outln!(
             "triangles left  {} (recorded {})",
-            out.triangles_left, record.triangles_left
+            out.triangles_left,
+            record.triangles_left
         );
-        println!(
+        outln!(
             "quality         {:.6} (recorded {:.6})",
-            out.quality, record.quality
+            out.quality,
+            record.quality
         );
         super::print_element_lines(&out.elements, rule);
-        println!(
+        outln!(
             "time            {:.4} s (recorded {:.4} s)",
-            out.time_s, record.time_s
+            out.time_s,
+            record.time_s
         );
         if let (Some(f), Some(rf)) = (&out.finish, &record.finish) {
-            println!(
+            outln!(
                 "finished        {} quads, {} triangles left, quality {:.6} (recorded {} quads, \
                  {} left, {:.6}; rings {}, window {}; finish {:.4} s, recorded {:.4} s)",
                 f.quads,
@@ -246,7 +249,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 rf.time_s
             );
             if let Some(a) = f.all_quad {
-                println!(
+                outln!(
                     "all-quad        {} boundary sides split, {} nodes added {} (recorded {})",
                     a.splits,
                     a.splits,
@@ -254,7 +257,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                     rf.splits()
                 );
                 if a.sheets > 0 {
-                    println!(
+                    outln!(
                         "sheets          {} sheets, {} nodes added (inside and on sides), {} triangles replaced by {} (recorded {} triangles added in all)",
                         a.sheets,
                         a.sheet_nodes,
@@ -266,9 +269,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             }
         }
         let same = if out.reproduced { "yes" } else { "no" };
-        println!("reproduced      {same}");
+        outln!("reproduced      {same}");
         if let Some(p) = write {
-            println!("wrote           {}", p.display());
+            outln!("wrote           {}", p.display());
         }
     }
     if !out.reproduced {

@@ -107,16 +107,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let mut v = paths_json(&paths);
         v["dir"] = serde_json::json!(args.dir);
         v["time_s"] = serde_json::json!(start.elapsed().as_secs_f64());
-        println!("{v}");
+        outln!("{v}");
         return Ok(ExitCode::SUCCESS);
     }
-    println!("{}", paths.markdown.display());
-    println!("{}", paths.html.display());
+    outln!("{}", paths.markdown.display());
+    outln!("{}", paths.html.display());
     for f in &paths.figures {
-        println!("{}", f.display());
+        outln!("{}", f.display());
     }
     if let Some(csv) = &paths.across_csv {
-        println!("{}", csv.display());
+        outln!("{}", csv.display());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -69,25 +69,32 @@ fn list(args: ListArgs) -> anyhow::Result<ExitCode> {
                 "about": about,
             })).collect::<Vec<_>>(),
         });
-        println!("{v}");
+        outln!("{v}");
         return Ok(ExitCode::SUCCESS);
     }
     let width = members.iter().map(|m| m.name.len()).max().unwrap_or(4);
-    println!(
+    outln!(
         "{:<width$}  {:>9}  {:>4}  {:<10}  what it tests",
-        "name", "triangles", "odd", "family"
+        "name",
+        "triangles",
+        "odd",
+        "family"
     );
     for m in &members {
-        println!(
+        outln!(
             "{:<width$}  {:>9}  {:>4}  {:<10}  {}",
-            m.name, m.triangles, m.odd_components, m.family, m.tests
+            m.name,
+            m.triangles,
+            m.odd_components,
+            m.family,
+            m.tests
         );
     }
-    println!();
-    println!("Use a member as --mesh suite:NAME (any command that takes a mesh).");
+    outln!();
+    outln!("Use a member as --mesh suite:NAME (any command that takes a mesh).");
     for (name, _, about) in SUITES {
         let n = suite::suite(name).map_or(0, |m| m.len());
-        println!("sweep --suite {name}: {n} meshes, {about}");
+        outln!("sweep --suite {name}: {n} meshes, {about}");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -288,7 +288,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .collect();
     if !fixed.is_empty() && !args.quiet {
         let n = config.baseline_runs();
-        eprintln!(
+        noteln!(
             "sweep: {} deterministic (the same run whatever the seed): {n} run{} each{}, not \
              --runs; --baseline-runs repeats them for timings",
             fixed.join(", "),
@@ -310,10 +310,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
     ctrlc::set_handler(|| {
         if CANCEL.swap(true, Ordering::SeqCst) {
-            eprintln!("\nsweep: interrupted again, exiting now (finished runs are saved)");
+            noteln!("\nsweep: interrupted again, exiting now (finished runs are saved)");
             std::process::exit(i32::from(EXIT_INTERRUPTED));
         }
-        eprintln!("\nsweep: interrupted: finishing the runs in flight (Ctrl-C again to quit now)");
+        noteln!("\nsweep: interrupted: finishing the runs in flight (Ctrl-C again to quit now)");
     })
     .context("installing the Ctrl-C handler")?;
 
@@ -349,13 +349,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "time_s": start.elapsed().as_secs_f64(),
             "phases": phases,
         });
-        println!("{v}");
+        outln!("{v}");
     };
     if report.cancelled {
         if args.json {
             json(serde_json::Value::Null, serde_json::Value::Null);
         }
-        eprintln!(
+        noteln!(
             "sweep: interrupted: {} of {} runs recorded in {}{shard}; run the same command with {} to finish",
             report.already + report.done_now,
             report.planned,
@@ -365,7 +365,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(EXIT_INTERRUPTED));
     }
     if !args.quiet {
-        eprintln!(
+        noteln!(
             "sweep: {} runs done ({} new, {} already recorded) into {}{shard}; backend {}",
             report.planned,
             report.done_now,
@@ -390,7 +390,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             )
         })?;
         if !args.quiet {
-            eprintln!("sweep: report in {}", paths.markdown.display());
+            noteln!("sweep: report in {}", paths.markdown.display());
         }
         report_paths = super::report::paths_json(&paths);
     }
@@ -401,7 +401,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         total_s: start.elapsed().as_secs_f64(),
     };
     if !args.quiet {
-        eprintln!("sweep: {}", timing.line());
+        noteln!("sweep: {}", timing.line());
     }
     if args.json {
         json(report_paths, timing.json());

@@ -54,17 +54,17 @@ impl SweepDisplay {
                     }
                 );
                 if self.mode != ProgressMode::Quiet || !info {
-                    eprintln!("quality backend: {note}");
+                    noteln!("quality backend: {note}");
                 }
             }
             Event::Calibrated(note) => {
                 if self.mode != ProgressMode::Quiet {
-                    eprintln!("{}", calibrated_line(note));
+                    noteln!("{}", calibrated_line(note));
                 }
             }
             Event::Extending { before, after } => {
                 if self.mode != ProgressMode::Quiet {
-                    eprintln!(
+                    noteln!(
                         "sweep: extending the sweep: its run list grows from {before} to {after} \
                          runs (the recorded ones are kept)"
                     );
@@ -76,7 +76,7 @@ impl SweepDisplay {
                 torn,
             } => {
                 if self.mode != ProgressMode::Quiet {
-                    eprintln!("{}", resuming_line(recorded, planned, torn));
+                    noteln!("{}", resuming_line(recorded, planned, torn));
                 }
             }
             Event::Started { runs } => self.progress = Some(Progress::new(self.mode, runs)),
@@ -164,7 +164,7 @@ impl Progress {
                     if *stop {
                         break;
                     }
-                    eprintln!("{}", line(&shared));
+                    noteln!("{}", line(&shared));
                 }
             })
         });
@@ -202,7 +202,7 @@ impl Progress {
             *self.shared.stop.lock().unwrap_or_else(|p| p.into_inner()) = true;
             self.shared.wake.notify_all();
             let _ = t.join();
-            eprintln!("{}", line(&self.shared));
+            noteln!("{}", line(&self.shared));
         }
     }
 }

@@ -594,3 +594,29 @@ fn bench_search_compares_greedy_on_named_meshes() {
     assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
     assert!(stderr(&o).contains("missing.msh"), "{}", stderr(&o));
 }
+
+/// A reader that stops early (`quadrecomb sweep ... 2>&1 | head -1`) must not turn the sweep
+/// into a panic (exit 101) that leaves no report: notes and results to a closed pipe are
+/// dropped, the work finishes.
+#[test]
+fn a_closed_pipe_does_not_cut_a_sweep_short() {
+    let tmp = tempfile::tempdir().unwrap();
+    let bin = crate::util::bin();
+    let script = format!(
+        "'{}' sweep --mesh sphere --algo greedy selective --horizons 1 --runs 4 --out s 2>&1 \
+         | head -1 >/dev/null; echo \"status ${{PIPESTATUS[0]}}\"",
+        bin.display()
+    );
+    let out = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(&script)
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(said.trim(), "status 0", "{}", stderr(&out));
+    assert!(
+        tmp.path().join("s/report.md").is_file(),
+        "the report was written"
+    );
+}

@@ -37,13 +37,21 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ..FinishConfig::default()
     };
     if !args.lattice_sizes.is_empty() {
-        println!(
+        outln!(
             "lattices (seed 2), selective h=3 seed 0 + finish (window {}), valid-quad rule",
             args.window
         );
-        println!(
+        outln!(
             "{:>10} {:>9} {:>9} {:>9} {:>8} {:>6} {:>9} {:>7} {:>11}",
-            "triangles", "sel_s", "finish_s", "opt_s", "%opt", "left", "raw%opt", "ratio", "us/tri"
+            "triangles",
+            "sel_s",
+            "finish_s",
+            "opt_s",
+            "%opt",
+            "left",
+            "raw%opt",
+            "ratio",
+            "us/tri"
         );
     }
     for &n in &args.lattice_sizes {
@@ -58,7 +66,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let opt_s = t.elapsed().as_secs_f64();
         let ours = out.time_s + f.time_s();
         let nt = mesh.num_triangles();
-        println!(
+        outln!(
             "{:>10} {:>9.3} {:>9.3} {:>9.3} {:>8.3} {:>6} {:>9.3} {:>7.3} {:>11.3}",
             nt,
             out.time_s,
@@ -71,7 +79,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             1e6 * ours / nt as f64,
         );
     }
-    println!("(ratio = (selective + finish time) / optimum time; us/tri = that time per triangle)");
+    outln!("(ratio = (selective + finish time) / optimum time; us/tri = that time per triangle)");
     for name in args.meshes.iter().filter(|m| !m.is_empty()) {
         let mesh = mesh::load(name)?;
         let table = CandidateTable::build(&mesh).restrict(&mesh, Rule::default());
@@ -87,7 +95,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 rec.push(100.0 * (2 * f.improved.quads) as f64 / mesh.num_triangles() as f64);
                 ts.push(f.time_s());
             }
-            println!(
+            outln!(
                 "{name} selective h={h}, {} runs: raw median {:.3} % of the optimum; finished \
                  median {:.3} % (min {:.3}), recombined median {:.3} % (min {:.3}); finish time \
                  median {:.3} s (optimum {:.3} s)",

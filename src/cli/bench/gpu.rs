@@ -110,7 +110,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if !args.cpu_only {
         let adapters = gpu::adapters();
         if adapters.is_empty() {
-            eprintln!("no Vulkan adapter found: CPU rows only");
+            noteln!("no Vulkan adapter found: CPU rows only");
         }
         for a in adapters {
             let info = a.get_info();
@@ -119,7 +119,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             let (kernel, device, queue) = match opened {
                 Ok(x) => x,
                 Err(e) => {
-                    eprintln!("skipping {name}: {e}");
+                    noteln!("skipping {name}: {e}");
                     continue;
                 }
             };
@@ -133,7 +133,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             let stream = bandwidth::stream_bandwidth(&device, &queue, probe)
                 .with_context(|| format!("measuring the stream bandwidth of {name}"))?;
             let bw = copy.max(stream);
-            println!(
+            outln!(
                 "device: {name} ({:?}, driver {} {}), bandwidth (read + write): buffer copy \
                  {:.1} GB/s, compute stream copy {:.1} GB/s; kernel timing: {}",
                 info.device_type,
@@ -171,7 +171,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             devices.push((name, device, queue, kernels, bw));
         }
     }
-    println!("host: {threads} threads for the CPU rows");
+    outln!("host: {threads} threads for the CPU rows");
 
     let mut rows = Vec::new();
     for &size in &args.sizes {
@@ -182,7 +182,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         batch.push(&vertices, &quads)?;
         let prepare_s = t.elapsed().as_secs_f64();
         let c = batch.len();
-        println!(
+        outln!(
             "\n{c} candidates ({n}x{n} jittered grid, {} vertices): host batch preparation \
              (f64 -> hi/lo f32, index offsets) {:.2} ms; at least {:.1} bytes per candidate \
              indexed, {} with local edges",
@@ -285,9 +285,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             }
         }
     }
-    println!("\nAll sizes:");
+    outln!("\nAll sizes:");
     print_rows(&rows);
-    println!(
+    outln!(
         "\nkernel, run = the run's dispatch (or dispatches, each after its upload), device \
          timestamps where supported, else submit + wait, at whatever clock the GPU is at; \
          warm = median of {} dispatches after {} ms of back-to-back ones (the GPU at its \
@@ -295,25 +295,26 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
          on the host clock, batch preparation excluded; Mcand/s kernel and the bound use the \
          warm time where there is one; bound = kernel bytes per second (bytes per candidate \
          above) / the better measured bandwidth.",
-        args.dispatches, args.warm_up_ms
+        args.dispatches,
+        args.warm_up_ms
     );
     Ok(ExitCode::SUCCESS)
 }
 
 fn print_rows(rows: &[Row]) {
-    println!(
+    outln!(
         "| backend | candidates | upload ms | kernel ms, run | kernel ms, warm | readback ms | \
          total ms | Mcand/s kernel | Mcand/s total | % of bandwidth bound | \
          max abs diff vs f64 |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    outln!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     let dash = || "-".to_string();
     for r in rows {
         let k = r.t.kernel_best_s();
         // Throughput and bound from the warm time where there is one.
         let kt = r.warm_s.unwrap_or(k);
         let bound = r.floor_s.map(|f| 100.0 * f / kt);
-        println!(
+        outln!(
             "| {} | {} | {:.3} | {:.3} | {} | {:.3} | {:.3} | {:.1} | {:.1} | {} | {} |",
             r.backend,
             r.candidates,
@@ -342,14 +343,14 @@ fn shapes(
     warm_up: std::time::Duration,
 ) -> anyhow::Result<()> {
     let c = batch.len() as f64;
-    println!(
+    outln!(
         "\nLaunch shapes on {name}, {} candidates, {dispatches} dispatches each after {} ms \
          of warm-up:",
         batch.len(),
         warm_up.as_millis()
     );
-    println!("| kernel | median ms | best ms | Gcand/s | % of bandwidth bound |");
-    println!("|---|---:|---:|---:|---:|");
+    outln!("| kernel | median ms | best ms | Gcand/s | % of bandwidth bound |");
+    outln!("|---|---:|---:|---:|---:|");
     let max_wg = device.limits().max_compute_invocations_per_workgroup;
     for layout in [Layout::Indexed, Layout::Local] {
         let floor_s = c * kernel_bytes(layout, batch) / bw;
@@ -363,14 +364,14 @@ fn shapes(
                 let k = Kernel::with_options(device, options)?;
                 k.run(device, queue, batch)?;
                 let Some(times) = k.dispatch_times(device, queue, dispatches, warm_up)? else {
-                    println!(
+                    outln!(
                         "| {options} | no warm time (no timestamps, or several dispatches) | | | |"
                     );
                     continue;
                 };
                 let best = times.iter().copied().fold(f64::INFINITY, f64::min);
                 let med = median(times);
-                println!(
+                outln!(
                     "| {options} | {:.4} | {:.4} | {:.2} | {:.0}% |",
                     med * 1e3,
                     best * 1e3,

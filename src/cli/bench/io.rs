@@ -43,14 +43,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         args.meshes
     };
-    println!(
+    outln!(
         "median of {} repetitions, {} threads available",
         args.reps,
         std::thread::available_parallelism().map_or(1, |n| n.get())
     );
-    println!(
+    outln!(
         "{:<28} {:>16} {:>10} {:>10} {:>12} {:>13}",
-        "mesh", "format", "triangles", "parse ms", "topology ms", "candidates ms"
+        "mesh",
+        "format",
+        "triangles",
+        "parse ms",
+        "topology ms",
+        "candidates ms"
     );
     for spec in &meshes {
         let src = mesh::source(spec)?;
@@ -83,7 +88,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let candidates = median_ms(args.reps, || {
             std::hint::black_box(CandidateTable::build(&m).len());
         });
-        println!(
+        outln!(
             "{:<28} {:>16} {:>10} {:>10.2} {:>12.2} {:>13.2}",
             spec,
             format,

@@ -73,13 +73,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.loads == 0 {
         return Err(UsageError("--loads must be at least 1".into()).into());
     }
-    println!(
+    outln!(
         "random loads of 8 bytes, {} per size and kind (ns per load; lower is faster)",
         args.loads
     );
-    println!(
+    outln!(
         "{:>8} {:>14} {:>16} {:>8}",
-        "MiB", "dependent ns", "independent ns", "ratio"
+        "MiB",
+        "dependent ns",
+        "independent ns",
+        "ratio"
     );
     let mut rng = ChaCha8Rng::seed_from_u64(2026);
     let mut mib = 1;
@@ -97,7 +100,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         dependent_ns(&next, next.len().min(args.loads));
         let dep = dependent_ns(&next, args.loads);
         let ind = independent_ns(&next, args.loads);
-        println!("{mib:>8} {dep:>14.1} {ind:>16.1} {:>8.1}", dep / ind);
+        outln!("{mib:>8} {dep:>14.1} {ind:>16.1} {:>8.1}", dep / ind);
         let Some(twice) = mib.checked_mul(2) else {
             break;
         };

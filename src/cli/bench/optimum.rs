@@ -60,12 +60,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let table = CandidateTable::build(&mesh);
         let opt = optimum::solve(&mesh, &table);
         std::hint::black_box(&opt);
-        println!("{} {}", mesh.num_triangles(), peak_rss().unwrap_or(0));
+        outln!("{} {}", mesh.num_triangles(), peak_rss().unwrap_or(0));
         return Ok(ExitCode::SUCCESS);
     }
-    println!(
+    outln!(
         "{:<22} {:>10} {:>9} {:>6} {:>14} {:>10} {:>10} {:>12}",
-        "mesh", "triangles", "quads", "left", "quality", "wall_ms", "cpu_ms", "rss_B/tri"
+        "mesh",
+        "triangles",
+        "quads",
+        "left",
+        "quality",
+        "wall_ms",
+        "cpu_ms",
+        "rss_B/tri"
     );
     for spec in &args.meshes {
         match quadrecomb::internals::mesh::load(spec) {
@@ -73,7 +80,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 let (opt, t, cpu) = time(&mesh, args.repeat);
                 print_row(spec, &mesh, &opt, t, cpu, None);
             }
-            Err(e) => println!("{spec:<22} (not loadable here: {e})"),
+            Err(e) => outln!("{spec:<22} (not loadable here: {e})"),
         }
     }
     let mut points = Vec::new();
@@ -90,7 +97,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         points.push((mesh.num_triangles() as f64, cpu.unwrap_or(t)));
     }
     if points.len() >= 2 {
-        println!(
+        outln!(
             "growth exponent (least-squares slope of log cpu time vs log triangles, grids): {:.2}",
             slope(&points)
         );
@@ -108,7 +115,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         points.push((mesh.num_triangles() as f64, cpu.unwrap_or(t)));
     }
     if points.len() >= 2 {
-        println!(
+        outln!(
             "growth exponent (least-squares slope of log cpu time vs log triangles, lattices): {:.2}",
             slope(&points)
         );
@@ -126,7 +133,7 @@ fn print_row(
 ) {
     let rss = rss.map_or("-".to_string(), |r| format!("{r:.0}"));
     let cpu = cpu.map_or("-".to_string(), |c| format!("{:.2}", 1e3 * c));
-    println!(
+    outln!(
         "{:<22} {:>10} {:>9} {:>6} {:>14.4} {:>10.2} {:>10} {:>12}",
         name,
         mesh.num_triangles(),

@@ -132,14 +132,19 @@ fn measure(args: &Args, exe: &Path, dir: &Path) -> anyhow::Result<ExitCode> {
     let mesh = generate::corridor(Corridor::Strip, 2, 0);
     quadrecomb::internals::mesh::msh::write(&tiny, &mesh, &Recombined::unrecombined(&mesh))?;
     let base = recombine(exe, &tiny, "greedy", 1)?;
-    println!(
+    outln!(
         "peak RSS of `quadrecomb recombine MESH --algo A --no-optimum` (child processes); \
          a 2-triangle mesh: {:.1} MiB",
         base.peak_bytes as f64 / (1 << 20) as f64
     );
-    println!(
+    outln!(
         "{:<7} {:>9} {:<14} {:>10} {:>9} {:>9}  status",
-        "shape", "triangles", "algo", "peak MiB", "B/tri", "search s"
+        "shape",
+        "triangles",
+        "algo",
+        "peak MiB",
+        "B/tri",
+        "search s"
     );
     let mut failed = false;
     let mut n = 10_000;
@@ -162,7 +167,7 @@ fn measure(args: &Args, exe: &Path, dir: &Path) -> anyhow::Result<ExitCode> {
                 } else {
                     algo.clone()
                 };
-                println!(
+                outln!(
                     "{shape:<7} {nt:>9} {label:<14} {:>10.1} {:>9.0} {:>9}  {}",
                     r.peak_bytes as f64 / (1 << 20) as f64,
                     r.peak_bytes as f64 / nt as f64,

@@ -137,7 +137,7 @@ fn greedy_row(name: &str, m: &mesh::Mesh, t: &CandidateTable, runs: u64) {
     }
     let (a, b) = last.expect("at least one round");
     let left = |r: &Row| (nt as f64 * (1.0 - r.recombined_pct / 100.0)).round();
-    println!(
+    outln!(
         "| {name} | {nt} | {} / {} | {:.1} | {:.1} | {:.2} | {:.3} / {:.1} | {:.3} / {:.1} |",
         left(&a),
         left(&b),
@@ -154,9 +154,16 @@ fn greedy_row(name: &str, m: &mesh::Mesh, t: &CandidateTable, runs: u64) {
 fn print_row(r: &Row) {
     let cpu = r.cpu_ms.map_or("-".into(), |c| format!("{c:.1}"));
     let q = r.quality_pct.map_or("-".into(), |q| format!("{q:.2}"));
-    println!(
+    outln!(
         "| {} | {} | {} | {:.1} | {} | {} | {:.2} | {:.2} |",
-        r.mesh, r.algo, r.runs, r.wall_ms, cpu, q, r.recombined_pct, r.nodes_per_decision
+        r.mesh,
+        r.algo,
+        r.runs,
+        r.wall_ms,
+        cpu,
+        q,
+        r.recombined_pct,
+        r.nodes_per_decision
     );
 }
 
@@ -180,35 +187,33 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         // Loaded before any timing: a bad file fails at once.
         compared.push((name, mesh::load(name)?));
     }
-    println!(
+    outln!(
         "Greedy against selective h=1, {RATIO_ROUNDS} rounds alternating them, {} seeds each \
          (greedy is deterministic): triangles left, median wall ms, the median of the rounds' \
          ratios greedy / selective, and the criterion's work per triangle (checks that needed \
          a search / triangles they visited). Rule: {rule}.\n",
         args.runs
     );
-    println!(
+    outln!(
         "| mesh | triangles | left, greedy / selective | greedy ms | selective h=1 ms | ratio \
          | greedy searches / searched | selective searches / searched |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    outln!("|---|---:|---:|---:|---:|---:|---:|---:|");
     for (name, m) in &compared {
         let t = CandidateTable::build(m).restrict(m, rule);
         greedy_row(name, m, &t, args.runs);
     }
-    println!();
+    outln!();
     if args.greedy_only {
         return Ok(ExitCode::SUCCESS);
     }
-    println!(
+    outln!(
         "Per run (median over seeds 0..{}): wall and thread-CPU milliseconds, quality as % of \
          the exact optimum, % of triangles recombined, nodes expanded per decision. Rule: {rule}.\n",
         args.runs
     );
-    println!(
-        "| mesh | algo | runs | wall ms | cpu ms | quality % | recombined % | nodes/decision |"
-    );
-    println!("|---|---|---:|---:|---:|---:|---:|---:|");
+    outln!("| mesh | algo | runs | wall ms | cpu ms | quality % | recombined % | nodes/decision |");
+    outln!("|---|---|---:|---:|---:|---:|---:|---:|");
     let b = mesh::load("borouchaki")?;
     let bt = CandidateTable::build(&b).restrict(&b, rule);
     let bopt = optimum::solve(&b, &bt).quality;
@@ -258,18 +263,18 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     drop(s);
 
-    println!(
+    outln!(
         "\nSelective h=3 on generated jittered grids (one surface, no hole), {GRID_ROUNDS} rounds \
          alternating the sizes (this VM's speed drifts from minute to minute): ns per triangle \
          of the search, median over the seeds of a round, best and worst round; and the work, \
          which does not depend on the machine: tree nodes expanded and triangles visited by the \
          criterion's searches, per triangle (medians over the seeds):\n"
     );
-    println!(
+    outln!(
         "| triangles | runs per round | ns per triangle (best round) | worst round | recombined % \
          | nodes per triangle | searched per triangle |"
     );
-    println!("|---:|---:|---:|---:|---:|---:|---:|");
+    outln!("|---:|---:|---:|---:|---:|---:|---:|");
     // As `generate grid` then `mesh::load` would give them: in spatial order.
     let mut grids = Vec::new();
     let mut n = FIRST_GRID;
@@ -316,7 +321,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let nt = g.num_triangles();
         let best = per[i].iter().copied().fold(f64::INFINITY, f64::min);
         let worst = per[i].iter().copied().fold(0.0, f64::max);
-        println!(
+        outln!(
             "| {nt} | {} | {best:.0} | {worst:.0} | {:.2} | {:.3} | {:.2} |",
             runs_for(nt),
             recombined[i],

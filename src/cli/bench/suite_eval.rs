@@ -182,7 +182,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None
     } else {
         Evaluator::new(Backend::Gpu)
-            .map_err(|e| eprintln!("no device ({e}): CPU twin only"))
+            .map_err(|e| noteln!("no device ({e}): CPU twin only"))
             .ok()
     };
     let mut ways: Vec<(&Evaluator, Way, &str)> = Vec::new();
@@ -234,22 +234,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 "readback_s": s.readback_s, "median_s": s.total_s, "cpu_s": s.cpu_s, "min_s": min, "max_s": max,
             })).collect::<Vec<_>>(),
         });
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!(
+        outln!(
             "suite {}: {} meshes, {triangles} triangles, {count} candidates; medians of {} \
              repetitions after a warm-up (each phase its own median; min - max of the totals)",
             args.suite,
             meshes.len(),
             args.repeat.max(1)
         );
-        println!(
+        outln!(
             "| backend | how | dispatches | prep ms | upload ms | kernel ms | readback ms | \
              total ms | min - max ms | Mcand/s | CPU ms |"
         );
-        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        outln!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
         for (backend, how, s, (min, max)) in &rows {
-            println!(
+            outln!(
                 "| {backend} | {how} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} - \
                  {:.2} | {:.1} | {:.1} |",
                 s.dispatches,
@@ -265,7 +265,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             );
         }
         if let [(_, _, one, _), (_, _, each, _), ..] = rows.as_slice() {
-            println!(
+            outln!(
                 "one batch takes {:.2}x the wall time of one submission per mesh (median \
                  totals; median of the per-repetition ratios {:.2}x) and {:.2}x its CPU time \
                  (per-repetition ratios {:.2}x); its eta is {} the per-mesh runs'",
