@@ -8,19 +8,19 @@ use super::{Config, Document, Run};
 use crate::experiment::summary::Summary;
 use crate::stats::describe::median;
 
-/// Whether some finished run of `runs` was refined by sheets (`--all-quad`): its mesh has more
-/// quads than the input's triangles allow, so its quality is not comparable to the input's
-/// optimum (it can exceed 100 %).
+/// Whether some finished run of `runs` was refined by all-quad (a boundary split or sheets):
+/// its mesh has more triangles, and so can have more quads, than the input, so its quality is
+/// not comparable to the input's optimum (it can exceed 100 %).
 fn refined(runs: &[Run]) -> bool {
     (runs.iter()).any(|r| {
         r.finish
             .as_ref()
             .and_then(|f| f.all_quad.as_ref())
-            .is_some_and(|a| a.sheets > 0)
+            .is_some_and(|a| a.splits > 0 || a.sheets > 0)
     })
 }
 
-/// A quality percentage, marked with a dagger when the runs were refined by sheets.
+/// A quality percentage, marked with a dagger when the runs were refined by all-quad.
 fn pct(v: Option<f64>, refined: bool) -> String {
     let s = fmt_opt(v, 2);
     if refined && v.is_some() {
@@ -31,13 +31,13 @@ fn pct(v: Option<f64>, refined: bool) -> String {
 }
 
 /// The note under a table whose rows carry a dagger.
-const REFINED_NOTE: &str = "† Some runs were refined by sheets (--all-quad, where no single \
-    boundary split could make a component even; docs/finish.md): their finished mesh has more \
-    quads than the input's triangles allow, so its quality is not comparable to the input's \
-    optimum (it can exceed 100 %). Compare their mean eta per quad instead (runs.jsonl, \
-    finish.mean_eta).";
+const REFINED_NOTE: &str = "† Some runs were refined by --all-quad (a boundary side split, or \
+    sheets where no single split could make a component even; docs/finish.md): their finished \
+    mesh has more triangles, and can hold more quads, than the input, so its quality is not \
+    comparable to the input's optimum (it can exceed 100 %). Compare their mean eta per quad \
+    instead (runs.jsonl, finish.mean_eta).";
 
-/// Whether any finished configuration of `configs` was refined by sheets.
+/// Whether any finished configuration of `configs` was refined by all-quad.
 pub(super) fn any_refined(configs: &[(&Config, &[Run])]) -> bool {
     configs.iter().any(|(_, runs)| refined(runs))
 }
