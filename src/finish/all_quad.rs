@@ -46,17 +46,7 @@ pub(crate) fn split(
 ) -> Result<SplitMesh, MeshError> {
     let nt = mesh.num_triangles();
     let pairing = &chosen.pairing;
-    let mut data = MeshData {
-        vertices: mesh.vertices.clone(),
-        vertex_ids: mesh.vertex_ids.clone(),
-        triangles: mesh.triangles.clone(),
-        triangle_ids: mesh.triangle_ids.clone(),
-        triangle_surface: mesh.triangle_surface.clone(),
-        quads: mesh.quads.clone(),
-        quad_ids: Vec::new(),
-        quad_surface: mesh.quad_surface.clone(),
-        model: mesh.model.clone(),
-    };
+    let mut data = editable_copy(mesh);
     let first_node = mesh.vertex_ids.iter().max().copied().unwrap_or(0) + 1;
     let first_element = mesh.triangle_ids.iter().max().copied().unwrap_or(0) + 1;
     let mut splits = Vec::new();
@@ -194,5 +184,22 @@ pub(crate) fn split_model_edge(
     }
     if !model.node_param.is_empty() {
         model.node_param.push(None);
+    }
+}
+
+/// `mesh`'s data, to add nodes and elements to (split sides, sheets): the input quads keep
+/// their corners and surfaces, not their tags (`Mesh::new` numbers them after the triangles,
+/// so the tags of added triangles cannot collide with them).
+pub(crate) fn editable_copy(mesh: &Mesh) -> MeshData {
+    MeshData {
+        vertices: mesh.vertices.clone(),
+        vertex_ids: mesh.vertex_ids.clone(),
+        triangles: mesh.triangles.clone(),
+        triangle_ids: mesh.triangle_ids.clone(),
+        triangle_surface: mesh.triangle_surface.clone(),
+        quads: mesh.quads.clone(),
+        quad_ids: Vec::new(),
+        quad_surface: mesh.quad_surface.clone(),
+        model: mesh.model.clone(),
     }
 }

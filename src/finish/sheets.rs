@@ -176,17 +176,7 @@ pub(crate) fn refine(
         }
     }
 
-    let mut data = MeshData {
-        vertices: mesh.vertices.clone(),
-        vertex_ids: mesh.vertex_ids.clone(),
-        triangles: mesh.triangles.clone(),
-        triangle_ids: mesh.triangle_ids.clone(),
-        triangle_surface: mesh.triangle_surface.clone(),
-        quads: mesh.quads.clone(),
-        quad_ids: Vec::new(),
-        quad_surface: mesh.quad_surface.clone(),
-        model: mesh.model.clone(),
-    };
+    let mut data = super::all_quad::editable_copy(mesh);
     let first_node = mesh.vertex_ids.iter().max().copied().unwrap_or(0) + 1;
     let mut next_node = first_node;
     let at = |data: &MeshData, v: u32| data.vertices[v as usize];
