@@ -348,6 +348,12 @@ pub fn search_knobs<E>(
         .collect())
 }
 
+/// The first 8 bytes of a pilot digest (the pilots' quads and quality), as a number.
+fn first_u64(digest: &blake3::Hasher) -> u64 {
+    let bytes = digest.finalize();
+    u64::from_le_bytes(bytes.as_bytes()[..8].try_into().expect("8 of 32 bytes"))
+}
+
 /// The largest probed knob up to `top` whose median is at most `limit`; the smallest probed
 /// when none.
 fn choose(probes: &[Probe], limit: f64, top: u32) -> Choice {
@@ -477,12 +483,7 @@ pub fn calibrate_spec(
                 digest.update(&(q as u64).to_le_bytes());
                 digest.update(&bits.to_le_bytes());
             }
-            let digest = u64::from_le_bytes(
-                digest.finalize().as_bytes()[..8]
-                    .try_into()
-                    .expect("8 bytes"),
-            );
-            Ok((times, digest))
+            Ok((times, first_u64(&digest)))
         };
         let targets: Vec<f64> = budgets.iter().map(|t| t.seconds()).collect();
         let mut probes = Vec::new();
@@ -576,12 +577,7 @@ pub fn calibrate_run(
             digest.update(&(out.quads as u64).to_le_bytes());
             digest.update(&out.quality.to_bits().to_le_bytes());
         }
-        let digest = u64::from_le_bytes(
-            digest.finalize().as_bytes()[..8]
-                .try_into()
-                .expect("8 bytes"),
-        );
-        Ok((times, digest))
+        Ok((times, first_u64(&digest)))
     };
     let mut probes = Vec::new();
     let choice = search_knobs(
