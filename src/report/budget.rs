@@ -172,9 +172,40 @@ fn figure(mesh: &str, name: &str, points: &[Point]) -> Result<String, ReportErro
     let mut algos: Vec<&str> = points.iter().map(|p| p.algo.as_str()).collect();
     algos.sort_unstable();
     algos.dedup();
-    let xs = points.iter().map(|p| p.nodes.max(1.0));
+    let lines: Vec<Line> = (algos.iter())
+        .map(|algo| {
+            let mut mine: Vec<&Point> = points.iter().filter(|p| p.algo == *algo).collect();
+            mine.sort_by(|a, b| a.nodes.total_cmp(&b.nodes));
+            let pts = mine.iter().map(|p| (p.nodes.max(1.0), p.q)).collect();
+            (algo.to_string(), pts)
+        })
+        .collect();
+    lines_figure(
+        &format!("{mesh}: quality against budget"),
+        "tree nodes expanded per decision (median)",
+        name,
+        &lines,
+        &COLORS,
+    )
+}
+
+/// One line of a quality-against-budget figure: its label and its points in drawing order,
+/// each `(x, [q1, median, q3])`.
+pub(super) type Line = (String, Vec<(f64, [f64; 3])>);
+
+/// Quality against a budget on a log x axis: one coloured line of medians per [`Line`], with
+/// its points and interquartile bars (the node-budget and the time-budget figures).
+pub(super) fn lines_figure(
+    title: &str,
+    x_desc: &str,
+    name: &str,
+    lines: &[Line],
+    colors: &[RGBColor],
+) -> Result<String, ReportError> {
+    let points = || lines.iter().flat_map(|(_, pts)| pts.iter());
+    let xs = points().map(|p| p.0);
     let (xmin, xmax) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
-    let ys = points.iter().flat_map(|p| [p.q[0], p.q[2]]);
+    let ys = points().flat_map(|p| [p.1[0], p.1[2]]);
     let (ymin, ymax) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
         (a.min(y), b.max(y))
     });
@@ -184,10 +215,7 @@ fn figure(mesh: &str, name: &str, points: &[Point]) -> Result<String, ReportErro
         let root = SVGBackend::with_string(&mut svg, super::plots::SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
         let mut chart = ChartBuilder::on(&root)
-            .caption(
-                format!("{mesh}: quality against budget"),
-                ("sans-serif", 18),
-            )
+            .caption(title, ("sans-serif", 18))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(60)
@@ -198,34 +226,29 @@ fn figure(mesh: &str, name: &str, points: &[Point]) -> Result<String, ReportErro
             .map_err(plot_err)?;
         chart
             .configure_mesh()
-            .x_desc("tree nodes expanded per decision (median)")
+            .x_desc(x_desc)
             .y_desc(name)
             .draw()
             .map_err(plot_err)?;
-        for (i, algo) in algos.iter().enumerate() {
-            let color = COLORS[i % COLORS.len()];
-            let mut mine: Vec<&Point> = points.iter().filter(|p| p.algo == *algo).collect();
-            mine.sort_by(|a, b| a.nodes.total_cmp(&b.nodes));
+        for (i, (label, pts)) in lines.iter().enumerate() {
+            let color = colors[i % colors.len()];
             chart
                 .draw_series(LineSeries::new(
-                    mine.iter().map(|p| (p.nodes.max(1.0), p.q[1])),
+                    pts.iter().map(|&(x, q)| (x, q[1])),
                     color.stroke_width(2),
                 ))
                 .map_err(plot_err)?
-                .label(*algo)
+                .label(label.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color));
             chart
-                .draw_series(mine.iter().map(|p| {
-                    PathElement::new(
-                        vec![(p.nodes.max(1.0), p.q[0]), (p.nodes.max(1.0), p.q[2])],
-                        color.stroke_width(1),
-                    )
+                .draw_series(pts.iter().map(|&(x, q)| {
+                    PathElement::new(vec![(x, q[0]), (x, q[2])], color.stroke_width(1))
                 }))
                 .map_err(plot_err)?;
             chart
                 .draw_series(
-                    mine.iter()
-                        .map(|p| Circle::new((p.nodes.max(1.0), p.q[1]), 3, color.filled())),
+                    pts.iter()
+                        .map(|&(x, q)| Circle::new((x, q[1]), 3, color.filled())),
                 )
                 .map_err(plot_err)?;
         }

@@ -5,9 +5,9 @@
 //! Holm, A12, bootstrap interval, as the report's other comparisons).
 
 use super::ReportError;
+use super::budget::{Line, lines_figure};
 use super::document::Document;
 use super::format::fmt_sig;
-use super::plots::plot_err;
 use super::results::{Config, Metric, Run};
 use super::significance::Family;
 use crate::experiment::calibrate::{TimeBudget, has_knob};
@@ -180,74 +180,22 @@ fn figure(mesh: &str, name: &str, rows: &[Row<'_>]) -> Result<String, ReportErro
         Some(_) => format!("{} h={}", r.config.algo, r.config.horizon.unwrap_or(0)),
         None => r.config.algo.clone(),
     };
-    let mut lines: Vec<String> = rows.iter().map(line_of).collect();
-    lines.sort_unstable();
-    lines.dedup();
-    let xs = rows.iter().map(|r| r.t.seconds());
-    let (xmin, xmax) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
-    let ys = rows.iter().flat_map(|r| [r.q[0], r.q[2]]);
-    let (ymin, ymax) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
-        (a.min(y), b.max(y))
-    });
-    let pad = ((ymax - ymin) * 0.08).max(1e-3);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, super::plots::SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_err)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                format!("{mesh}: quality against time budget"),
-                ("sans-serif", 18),
-            )
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(
-                ((xmin / 1.5)..(xmax * 1.5)).log_scale(),
-                (ymin - pad)..(ymax + pad),
-            )
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("time budget per run (s)")
-            .y_desc(name)
-            .draw()
-            .map_err(plot_err)?;
-        for (i, line) in lines.iter().enumerate() {
-            let color = COLORS[i % COLORS.len()];
-            let mut mine: Vec<&Row<'_>> = rows.iter().filter(|r| line_of(r) == *line).collect();
+    let mut labels: Vec<String> = rows.iter().map(line_of).collect();
+    labels.sort_unstable();
+    labels.dedup();
+    let lines: Vec<Line> = (labels.into_iter())
+        .map(|label| {
+            let mut mine: Vec<&Row<'_>> = rows.iter().filter(|r| line_of(r) == label).collect();
             mine.sort_by_key(|r| r.t);
-            chart
-                .draw_series(LineSeries::new(
-                    mine.iter().map(|r| (r.t.seconds(), r.q[1])),
-                    color.stroke_width(2),
-                ))
-                .map_err(plot_err)?
-                .label(line.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color));
-            chart
-                .draw_series(mine.iter().map(|r| {
-                    PathElement::new(
-                        vec![(r.t.seconds(), r.q[0]), (r.t.seconds(), r.q[2])],
-                        color.stroke_width(1),
-                    )
-                }))
-                .map_err(plot_err)?;
-            chart
-                .draw_series(
-                    mine.iter()
-                        .map(|r| Circle::new((r.t.seconds(), r.q[1]), 3, color.filled())),
-                )
-                .map_err(plot_err)?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::LowerRight)
-            .draw()
-            .map_err(plot_err)?;
-        root.present().map_err(plot_err)?;
-    }
-    Ok(svg)
+            let pts = mine.iter().map(|r| (r.t.seconds(), r.q)).collect();
+            (label, pts)
+        })
+        .collect();
+    lines_figure(
+        &format!("{mesh}: quality against time budget"),
+        "time budget per run (s)",
+        name,
+        &lines,
+        &COLORS,
+    )
 }
