@@ -29,6 +29,9 @@ const OPTIMUM: &str = "optimum";
 struct Cell {
     median: f64,
     runs: usize,
+    /// The horizon the runs on this mesh had (a time budget's calibration chooses it per
+    /// mesh).
+    horizon: Option<u32>,
 }
 
 /// The per-mesh medians the section is made of.
@@ -38,7 +41,8 @@ struct Medians<'r> {
     meshes: Vec<&'r str>,
     /// Meshes left out (no optimum recorded, so no % to compare across meshes).
     left_out: Vec<&'r str>,
-    /// Methods in report order (a configuration without its mesh), the optimum left out.
+    /// Methods in report order ([`Config::method`]: a configuration without its mesh or a
+    /// time budget's calibrated knob), the optimum left out.
     methods: Vec<Config>,
     /// `cells[mesh][method]`, `None` where the method was not run on the mesh.
     cells: Vec<Vec<Option<Cell>>>,
@@ -52,8 +56,7 @@ impl<'r> Medians<'r> {
         }
         let mut methods: Vec<Config> = Vec::new();
         for c in results.groups.keys().filter(|c| c.algo != OPTIMUM) {
-            let mut m = c.clone();
-            m.mesh.clear();
+            let m = c.method();
             if !methods.contains(&m) {
                 methods.push(m);
             }
@@ -69,6 +72,7 @@ impl<'r> Medians<'r> {
                     Some(Cell {
                         median,
                         runs: runs.len(),
+                        horizon: c.horizon,
                     })
                 })
                 .collect();
@@ -159,9 +163,7 @@ pub(super) fn csv(results: &Results, summary: &Summary) -> Option<String> {
                 csv_field(m.meshes[i]),
                 csv_field(&m.label(j)),
                 csv_field(&m.methods[j].algo),
-                m.methods[j]
-                    .horizon
-                    .map_or(String::new(), |h| h.to_string()),
+                cell.horizon.map_or(String::new(), |h| h.to_string()),
                 cell.runs,
                 cell.median,
             ));

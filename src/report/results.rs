@@ -61,6 +61,23 @@ impl Config {
             None => label,
         }
     }
+
+    /// The method as compared across meshes: the configuration without its mesh and, when
+    /// it was calibrated to a time budget, without the knob the calibration chose (each mesh
+    /// gets its own: selective's horizon, a budgeted tree's node budget), so that
+    /// "selective (T=0.5s)" is one method on every mesh.
+    pub fn method(&self) -> Config {
+        let mut m = self.clone();
+        m.mesh.clear();
+        if m.time_budget.is_some() {
+            if m.budget.is_some() {
+                m.budget = None;
+            } else {
+                m.horizon = None;
+            }
+        }
+        m
+    }
 }
 
 /// Order of algorithms in tables: the registry's ranks (baselines first, then uniform,
@@ -168,17 +185,12 @@ impl Results {
     }
 
     /// The runs of `method` (a configuration whatever its mesh: algorithm, horizon, node
-    /// budget and time budget) on `mesh`, if present.
+    /// budget and time budget; a time budget's calibrated knob may differ, see
+    /// [`Config::method`]) on `mesh`, if present.
     pub fn get_on(&self, mesh: &str, method: &Config) -> Option<&[Run]> {
         self.groups
             .iter()
-            .find(|(c, _)| {
-                c.mesh == mesh
-                    && c.algo == method.algo
-                    && c.horizon == method.horizon
-                    && c.budget == method.budget
-                    && c.time_budget == method.time_budget
-            })
+            .find(|(c, _)| c.mesh == mesh && c.method() == method.method())
             .map(|(_, r)| r.as_slice())
     }
 

@@ -338,3 +338,47 @@ fn each_node_budget_keeps_its_own_runs_across_meshes() {
         }
     }
 }
+
+#[test]
+fn a_time_budget_is_one_method_across_meshes() {
+    // Two meshes, selective calibrated to T = 0.5 s: the calibration chose h=8 on one and h=2
+    // on the other. The section took each (algorithm, horizon) for a method of its own, run
+    // on one mesh only, and left both out of the ranks; they are one method, "selective
+    // (T=0.5s)", with each mesh's own horizon in across_meshes.csv.
+    let tmp = tempfile::tempdir().unwrap();
+    let mut lines = Vec::new();
+    for (i, (mesh, h)) in [("a", 8u32), ("b", 2)].iter().enumerate() {
+        for run in 0..5 {
+            let base = 90.0 + i as f64 + f64::from(run) * 0.1;
+            lines.push(record(mesh, "selective", Some(1), run, base, 95.0, 0.05));
+            let mut r: serde_json::Value = serde_json::from_str(&record(
+                mesh,
+                "selective",
+                Some(*h),
+                run,
+                base + 3.0,
+                95.0,
+                0.05,
+            ))
+            .unwrap();
+            r["time_budget_s"] = 0.5.into();
+            lines.push(r.to_string());
+        }
+    }
+    std::fs::write(tmp.path().join("runs.jsonl"), lines.join("\n") + "\n").unwrap();
+    let paths = report::write(tmp.path(), &opts()).unwrap();
+    let csv =
+        std::fs::read_to_string(paths.across_csv.expect("across_meshes.csv written")).unwrap();
+    for (i, (mesh, h)) in [("a", 8u32), ("b", 2)].iter().enumerate() {
+        let line = (csv.lines())
+            .find(|l| l.starts_with(&format!("{mesh},")) && l.contains(",selective (T=0.5s),"))
+            .unwrap_or_else(|| panic!("no {mesh} time-budget row in\n{csv}"));
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f[4], h.to_string(), "{line}");
+        let median: f64 = f[6].parse().unwrap();
+        assert!((median - (93.2 + i as f64)).abs() < 1e-9, "{line}");
+        assert_eq!(f[7], "1", "ranked first on every mesh: {line}\n{csv}");
+    }
+    let md = std::fs::read_to_string(&paths.markdown).unwrap();
+    assert!(!md.contains("Not run on every mesh"), "{md}");
+}
