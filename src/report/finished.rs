@@ -1,5 +1,6 @@
 //! The finished runs of `sweep --finish` in a mesh's section: one "+ finish" row per
-//! configuration in the results table, and what the finish added (raw vs finished medians).
+//! configuration in the results table, and what the finish added (raw vs finished medians;
+//! every finished configuration, node- and time-budgeted ones included).
 //! Nothing is written for runs without a finish.
 
 use super::format::{fmt_opt, fmt_sig};
@@ -104,11 +105,15 @@ pub(super) fn what_it_added(doc: &mut Document, summary: &Summary, configs: &[(&
         let whole = |b: Option<&crate::stats::describe::BoxStats>| {
             b.filter(|b| b.n == g.n).map(|b| b.median)
         };
+        let mut algorithm = match c.budget {
+            Some(b) => format!("{} b={b}", c.algo),
+            None => c.algo.clone(),
+        };
+        if let Some(t) = c.time_budget {
+            algorithm.push_str(&format!(" (T={}s)", t.seconds()));
+        }
         rows.push(vec![
-            match c.budget {
-                Some(b) => format!("{} b={b}", c.algo),
-                None => c.algo.clone(),
-            },
+            algorithm,
             c.horizon.map_or("–".into(), |h| h.to_string()),
             g.n.to_string(),
             fmt_opt(median_of(summary, c, |g| g.quality_pct.as_ref()), 2),

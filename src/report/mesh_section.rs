@@ -124,7 +124,9 @@ pub(super) fn mesh_section(
     if super::finished::any_refined(&configs) {
         doc.para(super::finished::refined_note());
     }
-    super::finished::what_it_added(doc, summary, &configs);
+    // Every finished configuration, the budgeted and time-budget ones included: their own
+    // sections show no finish.
+    super::finished::what_it_added(doc, summary, &every);
     element_table(doc, summary, &configs);
     greedy_paradox(doc, &configs);
     super::beside_paper::paper_beside(doc, summary, mesh, &configs);

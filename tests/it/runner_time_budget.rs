@@ -392,3 +392,45 @@ fn recombine_calibrates_its_knob_and_says_how_to_repeat_the_run() {
         (w["quads"].clone(), w["quality"].clone())
     );
 }
+
+#[test]
+fn the_report_shows_what_the_finish_added_to_time_budgeted_runs() {
+    // `sweep --time-budgets --finish`: the finished runs of the calibrated configurations
+    // were in summary.csv but nowhere in the report (Table 1 and its finish rows leave the
+    // budgeted configurations to their own section, which shows no finish).
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = small_mesh(dir.path(), 400);
+    let mut args = sweep_args(&mesh, "t", 2, "1");
+    args.retain(|a| a != "--no-report");
+    let out = sweep(
+        dir.path(),
+        &args,
+        &[
+            "--algo",
+            "selective",
+            "--time-budgets",
+            "0.02",
+            "--finish",
+            "--threads",
+            "1",
+        ],
+    );
+    assert!(out.status.success(), "sweep: {}", stderr(&out));
+    let report = std::fs::read_to_string(dir.path().join("t/report.md")).unwrap();
+    let added = report
+        .split("### What the finish added")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no finish table in\n{report}"));
+    let rows: Vec<&str> = (added.lines())
+        .filter(|l| l.starts_with("| selective"))
+        .collect();
+    assert!(
+        rows.iter()
+            .any(|l| l.starts_with("| selective (T=0.02s) |")),
+        "{added}"
+    );
+    assert!(
+        rows.iter().any(|l| l.starts_with("| selective |")),
+        "{added}"
+    );
+}
