@@ -106,6 +106,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let t = Instant::now();
     let file = mesh::msh::parse(&src.path, &src.bytes)?;
     let parse = ms(t);
+    // The file's bytes are not needed past the parse: free them before the mesh is built.
+    let src = mesh::Source {
+        bytes: Vec::new().into(),
+        ..src
+    };
     let format = format!(
         "msh {} {}",
         file.version,
