@@ -37,38 +37,137 @@ impl Topology {
     }
 }
 
-/// The error for a mesh with non-manifold edges, the same whatever the order of the nodes
-/// and elements (the file's, or the spatial order of a loaded mesh): the edge with the
-/// smallest node tags, its nodes in increasing tag, its first elements in increasing tag.
-/// `half`: sorted half-edges `(a, b, element, ...)` as in [`build`].
-fn non_manifold<T>(
-    half: &[(u32, u32, u32, T)],
-    vertex_ids: &[u64],
-    element_id: impl Fn(u32) -> u64,
-) -> MeshError {
-    let mut worst: Option<(u64, u64, Vec<u64>)> = None;
-    for group in half.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-        if group.len() <= 2 {
-            continue;
+/// Every element's sides (half-edges), grouped by edge: a counting sort on the smaller
+/// vertex, each vertex's list sorted by (larger vertex, element), the order of a sort of
+/// `(min, max, element)` tuples in 8 bytes per half-edge and 4 per vertex (the tuples and
+/// their sort took 16 per half-edge, the topology build's peak). Elements `nt..` are the
+/// quads.
+struct HalfEdges {
+    /// `start[a]..start[a + 1]`: the entries of the sides whose smaller vertex is `a`.
+    start: Vec<u32>,
+    /// (larger vertex, element) of each side.
+    entries: Vec<(u32, u32)>,
+}
+
+impl HalfEdges {
+    /// The sides of `data`'s triangles and quads (node indices checked); the mesh is too
+    /// large when they do not fit in `u32` indices.
+    fn new(data: &MeshData, nt: usize) -> Result<HalfEdges, MeshError> {
+        let nv = data.vertices.len();
+        let count = 3 * nt as u64 + 4 * data.quads.len() as u64;
+        if count >= u64::from(NONE) {
+            return Err(MeshError::TooLarge {
+                vertices: nv,
+                triangles: nt,
+            });
         }
-        let (ta, tb) = (
-            vertex_ids[group[0].0 as usize],
-            vertex_ids[group[0].1 as usize],
-        );
-        let key = (ta.min(tb), ta.max(tb));
-        if worst.as_ref().is_none_or(|w| key < (w.0, w.1)) {
-            let mut elements: Vec<u64> = group.iter().map(|h| element_id(h.2)).collect();
-            elements.sort_unstable();
-            worst = Some((key.0, key.1, elements));
+        let sides = || {
+            let tris = data.triangles.iter().flat_map(|t| {
+                (0..3).map(move |i| (t[i].min(t[(i + 1) % 3]), t[i].max(t[(i + 1) % 3])))
+            });
+            let quads = data.quads.iter().flat_map(|q| {
+                (0..4).map(move |i| (q[i].min(q[(i + 1) % 4]), q[i].max(q[(i + 1) % 4])))
+            });
+            tris.chain(quads)
+        };
+        let mut start = vec![0u32; nv + 1];
+        for (a, _) in sides() {
+            start[a as usize + 1] += 1;
+        }
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        // Filled with start[a] as the cursor; it ends at the next list's start.
+        let mut entries = vec![(0u32, 0u32); count as usize];
+        for (k, (a, b)) in sides().enumerate() {
+            let element = if k < 3 * nt {
+                k / 3
+            } else {
+                nt + (k - 3 * nt) / 4
+            };
+            let slot = &mut start[a as usize];
+            entries[*slot as usize] = (b, element as u32);
+            *slot += 1;
+        }
+        start.copy_within(0..nv, 1);
+        start[0] = 0;
+        for v in 0..nv {
+            entries[start[v] as usize..start[v + 1] as usize].sort_unstable();
+        }
+        Ok(HalfEdges { start, entries })
+    }
+
+    /// The edges in increasing (smaller vertex, larger vertex): each with the
+    /// (larger vertex, element) of its sides, elements increasing.
+    fn groups(&self) -> impl Iterator<Item = (u32, u32, &[(u32, u32)])> {
+        self.start.windows(2).enumerate().flat_map(move |(a, w)| {
+            self.entries[w[0] as usize..w[1] as usize]
+                .chunk_by(|x, y| x.0 == y.0)
+                .map(move |g| (a as u32, g[0].0, g))
+        })
+    }
+
+    /// Two triangles with the same three vertices, if any: of the smallest sorted vertex
+    /// triple, its first two triangles (in index order).
+    fn duplicate_triangle(&self, triangles: &[[u32; 3]]) -> Option<(u32, u32)> {
+        let mut third: Vec<(u32, u32)> = Vec::new();
+        for (a, b, group) in self.groups() {
+            if group.len() < 2 {
+                continue;
+            }
+            // The triangles whose two smallest vertices are a and b, by their third.
+            third.clear();
+            third.extend(group.iter().filter_map(|&(_, t)| {
+                let c = triangles
+                    .get(t as usize)?
+                    .iter()
+                    .find(|&&v| v != a && v != b)?;
+                (*c > b).then_some((*c, t))
+            }));
+            third.sort_unstable();
+            if let Some(w) = third.windows(2).find(|w| w[0].0 == w[1].0) {
+                return Some((w[0].1, w[1].1));
+            }
+        }
+        None
+    }
+
+    /// The error for a mesh with non-manifold edges, the same whatever the order of the
+    /// nodes and elements (the file's, or the spatial order of a loaded mesh): the edge
+    /// with the smallest node tags, its nodes in increasing tag, its first elements in
+    /// increasing tag.
+    fn non_manifold(&self, vertex_ids: &[u64], element_id: impl Fn(u32) -> u64) -> MeshError {
+        let mut worst: Option<(u64, u64, Vec<u64>)> = None;
+        for (a, b, group) in self.groups() {
+            if group.len() <= 2 {
+                continue;
+            }
+            let (ta, tb) = (vertex_ids[a as usize], vertex_ids[b as usize]);
+            let key = (ta.min(tb), ta.max(tb));
+            if worst.as_ref().is_none_or(|w| key < (w.0, w.1)) {
+                let mut elements: Vec<u64> = group.iter().map(|h| element_id(h.1)).collect();
+                elements.sort_unstable();
+                worst = Some((key.0, key.1, elements));
+            }
+        }
+        let (a, b, elements) = worst.expect("a non-manifold edge");
+        MeshError::NonManifoldEdge {
+            a,
+            b,
+            count: elements.len(),
+            elements: elements.into_iter().take(4).collect(),
         }
     }
-    let (a, b, elements) = worst.expect("a non-manifold edge");
-    MeshError::NonManifoldEdge {
-        a,
-        b,
-        count: elements.len(),
-        elements: elements.into_iter().take(4).collect(),
-    }
+}
+
+/// The side of triangle `tri` whose ends are `a` and `b` (in either direction).
+fn side_of(tri: [u32; 3], a: u32, b: u32) -> usize {
+    (0..3)
+        .find(|&i| {
+            let (u, v) = (tri[i], tri[(i + 1) % 3]);
+            (u == a && v == b) || (u == b && v == a)
+        })
+        .expect("a side of the triangle")
 }
 
 /// Validates `data` and builds the mesh with its topology.
@@ -109,42 +208,13 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             });
         }
     }
-    // Duplicate triangles: same vertex set.
-    let mut keys: Vec<([u32; 3], u32)> = data
-        .triangles
-        .iter()
-        .enumerate()
-        .map(|(t, tri)| {
-            let mut k = *tri;
-            k.sort_unstable();
-            (k, t as u32)
-        })
-        .collect();
-    keys.sort_unstable();
-    for w in keys.windows(2) {
-        if w[0].0 == w[1].0 {
-            return Err(MeshError::DuplicateTriangle {
-                element: data.triangle_ids[w[1].1 as usize],
-                first: data.triangle_ids[w[0].1 as usize],
-            });
-        }
+    let half = HalfEdges::new(&data, nt)?;
+    if let Some((first, second)) = half.duplicate_triangle(&data.triangles) {
+        return Err(MeshError::DuplicateTriangle {
+            element: data.triangle_ids[second as usize],
+            first: data.triangle_ids[first as usize],
+        });
     }
-
-    // Half-edges of every element: (min, max, element, side). Quads are elements nt.. .
-    let mut half: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * nt + 4 * data.quads.len());
-    for (t, tri) in data.triangles.iter().enumerate() {
-        for i in 0..3 {
-            let (a, b) = (tri[i], tri[(i + 1) % 3]);
-            half.push((a.min(b), a.max(b), t as u32, i as u8));
-        }
-    }
-    for (q, quad) in data.quads.iter().enumerate() {
-        for i in 0..4 {
-            let (a, b) = (quad[i], quad[(i + 1) % 4]);
-            half.push((a.min(b), a.max(b), (nt + q) as u32, i as u8));
-        }
-    }
-    half.sort_unstable();
 
     let element_id = |e: u32| -> u64 {
         let e = e as usize;
@@ -154,45 +224,39 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             data.quad_ids[e - nt]
         }
     };
-    let mut edges = Vec::with_capacity(half.len() / 2 + 16);
+    // Counted first: resident for the mesh's life, these arrays are allocated to their size
+    // (a strip has 2 edges per triangle, one of them on the boundary).
+    let (num_edges, num_boundary) = half.groups().fold((0, 0), |(e, b), (_, _, g)| {
+        (e + 1, b + usize::from(g.len() == 1))
+    });
+    let mut edges = Vec::with_capacity(num_edges);
     let mut triangle_edges = vec![[NONE; 3]; nt];
     let mut neighbours = vec![[NONE; 3]; nt];
-    let mut boundary_edges = Vec::new();
-    // Pairs of triangles (t, side, u, side) on the same surface sharing an edge.
-    let mut links: Vec<(u32, u8, u32, u8)> = Vec::new();
-    let mut i = 0;
-    while i < half.len() {
-        let (a, b) = (half[i].0, half[i].1);
-        let mut j = i + 1;
-        while j < half.len() && half[j].0 == a && half[j].1 == b {
-            j += 1;
-        }
-        let group = &half[i..j];
+    let mut boundary_edges = Vec::with_capacity(num_boundary);
+    for (a, b, group) in half.groups() {
         if group.len() > 2 {
-            return Err(non_manifold(&half, &data.vertex_ids, element_id));
+            return Err(half.non_manifold(&data.vertex_ids, element_id));
         }
         let e = edges.len() as u32;
         edges.push([a, b]);
         if group.len() == 1 {
             boundary_edges.push(e);
         }
-        for h in group {
-            if (h.2 as usize) < nt {
-                triangle_edges[h.2 as usize][h.3 as usize] = e;
+        let side = |t: u32| side_of(data.triangles[t as usize], a, b);
+        for &(_, t) in group {
+            if (t as usize) < nt {
+                triangle_edges[t as usize][side(t)] = e;
             }
         }
-        if let [h0, h1] = group {
-            let (t, u) = (h0.2 as usize, h1.2 as usize);
-            if t < nt && u < nt && data.triangle_surface[t] == data.triangle_surface[u] {
-                links.push((h0.2, h0.3, h1.2, h1.3));
+        if let [(_, t), (_, u)] = *group {
+            let (ti, ui) = (t as usize, u as usize);
+            if ti < nt && ui < nt && data.triangle_surface[ti] == data.triangle_surface[ui] {
+                neighbours[ti][side(t)] = u;
+                neighbours[ui][side(u)] = t;
             }
         }
-        i = j;
     }
-    for &(t, si, u, sj) in &links {
-        neighbours[t as usize][si as usize] = u;
-        neighbours[u as usize][sj as usize] = t;
-    }
+    drop(half);
 
     // Components, and consistent orientation within each (flip[t] = reverse t).
     let mut component = vec![NONE; nt];
