@@ -5,6 +5,8 @@ pub mod builtin;
 mod error;
 pub mod generate;
 mod load;
+#[cfg(test)]
+mod load_memory;
 pub mod msh;
 pub mod order;
 pub mod suite;
