@@ -72,12 +72,11 @@ impl Model {
     /// Follows a permutation of the vertices: new vertex `i` is old vertex `from[i]`, old
     /// vertex `v` is new vertex `new_index[v]`.
     pub fn renumber(&mut self, from: &[u32], new_index: &[u32]) {
-        let mut done = Vec::new();
         if self.node_entity.len() == from.len() {
-            crate::mesh::order::permute(&mut self.node_entity, from, &mut done);
+            self.node_entity = from.iter().map(|&v| self.node_entity[v as usize]).collect();
         }
         if self.node_param.len() == from.len() {
-            crate::mesh::order::permute(&mut self.node_param, from, &mut done);
+            self.node_param = from.iter().map(|&v| self.node_param[v as usize]).collect();
         }
         for e in &mut self.elements {
             for v in &mut e.nodes {
