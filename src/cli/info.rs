@@ -175,7 +175,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         surfaces: m.surfaces().len(),
         components: topo.component_sizes.len(),
         odd_components: topo.component_sizes.iter().filter(|&&s| s % 2 == 1).count(),
-        boundary_edges: topo.boundary_edges.len(),
+        boundary_edges: topo.num_boundary_edges,
         candidate_pairs: table.len(),
         valid_pairs: table
             .eta

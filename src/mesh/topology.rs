@@ -1,29 +1,62 @@
-//! Topology built once from validated mesh data: unique edges, the dual graph (neighbours
-//! across each triangle side, same surface only), boundary edges and connected components.
-//! Also validation and consistent re-orientation of the input. Knows no geometry except the
-//! zero-area test.
+//! Topology built once from validated mesh data: the dual graph (neighbours across each
+//! triangle side, same surface only), the numbers of edges and boundary edges, and the
+//! connected components; the edges themselves on demand ([`Edges`]). Also validation and
+//! consistent re-orientation of the input. Knows no geometry except the zero-area test.
 
 use super::{Mesh, MeshData, MeshError, NONE};
 
-/// Edges, dual graph and components of a [`Mesh`].
+/// Dual graph and components of a [`Mesh`], kept for its life (the edges, which the
+/// searches never read, are computed when asked for: [`Mesh::edges`]).
 ///
 /// Side `i` of triangle `t` is the edge from `triangles[t][i]` to `triangles[t][(i + 1) % 3]`.
 #[derive(Debug, Clone, Default)]
 pub struct Topology {
+    /// Dual graph: the triangle across each side, or [`NONE`] on a boundary, next to a quad,
+    /// or across a surface boundary.
+    pub neighbours: Vec<[u32; 3]>,
+    /// Number of unique edges, over triangles and input quads.
+    pub num_edges: usize,
+    /// Number of edges used by exactly one element (triangle or quad).
+    pub num_boundary_edges: usize,
+    /// Number of triangles in each connected component of the dual graph, the components
+    /// numbered in order of their first triangle.
+    pub component_sizes: Vec<u32>,
+}
+
+/// The edges of a [`Mesh`] ([`Mesh::edges`]), numbered in increasing vertex pair.
+#[derive(Debug, Clone, Default)]
+pub struct Edges {
     /// Unique edges as sorted vertex pairs, over triangles and input quads.
     pub edges: Vec<[u32; 2]>,
     /// Edge index of each triangle side.
     pub triangle_edges: Vec<[u32; 3]>,
-    /// Dual graph: the triangle across each side, or [`NONE`] on a boundary, next to a quad,
-    /// or across a surface boundary.
-    pub neighbours: Vec<[u32; 3]>,
     /// Edges used by exactly one element (triangle or quad).
     pub boundary_edges: Vec<u32>,
-    /// Connected component (of the dual graph) of each triangle, numbered in order of first
-    /// triangle.
-    pub component: Vec<u32>,
-    /// Number of triangles in each component.
-    pub component_sizes: Vec<u32>,
+}
+
+/// The edges of `mesh` (see [`Edges`]).
+pub(super) fn edges(mesh: &Mesh) -> Edges {
+    let nt = mesh.triangles.len();
+    let half = HalfEdges::new(mesh.vertices.len(), &mesh.triangles, &mesh.quads)
+        .expect("a built mesh's sides fit in u32");
+    let mut out = Edges {
+        edges: Vec::with_capacity(mesh.topology.num_edges),
+        triangle_edges: vec![[NONE; 3]; nt],
+        boundary_edges: Vec::with_capacity(mesh.topology.num_boundary_edges),
+    };
+    for (a, b, group) in half.groups() {
+        let e = out.edges.len() as u32;
+        out.edges.push([a, b]);
+        if group.len() == 1 {
+            out.boundary_edges.push(e);
+        }
+        for &(_, t) in group {
+            if let Some(&tri) = mesh.triangles.get(t as usize) {
+                out.triangle_edges[t as usize][side_of(tri, a, b)] = e;
+            }
+        }
+    }
+    out
 }
 
 impl Topology {
@@ -52,9 +85,9 @@ struct HalfEdges {
 impl HalfEdges {
     /// The sides of `data`'s triangles and quads (node indices checked); the mesh is too
     /// large when they do not fit in `u32` indices.
-    fn new(data: &MeshData, nt: usize) -> Result<HalfEdges, MeshError> {
-        let nv = data.vertices.len();
-        let count = 3 * nt as u64 + 4 * data.quads.len() as u64;
+    fn new(nv: usize, triangles: &[[u32; 3]], quads: &[[u32; 4]]) -> Result<HalfEdges, MeshError> {
+        let nt = triangles.len();
+        let count = 3 * nt as u64 + 4 * quads.len() as u64;
         if count >= u64::from(NONE) {
             return Err(MeshError::TooLarge {
                 vertices: nv,
@@ -62,10 +95,10 @@ impl HalfEdges {
             });
         }
         let sides = || {
-            let tris = data.triangles.iter().flat_map(|t| {
+            let tris = triangles.iter().flat_map(|t| {
                 (0..3).map(move |i| (t[i].min(t[(i + 1) % 3]), t[i].max(t[(i + 1) % 3])))
             });
-            let quads = data.quads.iter().flat_map(|q| {
+            let quads = quads.iter().flat_map(|q| {
                 (0..4).map(move |i| (q[i].min(q[(i + 1) % 4]), q[i].max(q[(i + 1) % 4])))
             });
             tris.chain(quads)
@@ -208,7 +241,7 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             });
         }
     }
-    let half = HalfEdges::new(&data, nt)?;
+    let half = HalfEdges::new(nv, &data.triangles, &data.quads)?;
     if let Some((first, second)) = half.duplicate_triangle(&data.triangles) {
         return Err(MeshError::DuplicateTriangle {
             element: data.triangle_ids[second as usize],
@@ -224,30 +257,15 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             data.quad_ids[e - nt]
         }
     };
-    // Counted first: resident for the mesh's life, these arrays are allocated to their size
-    // (a strip has 2 edges per triangle, one of them on the boundary).
-    let (num_edges, num_boundary) = half.groups().fold((0, 0), |(e, b), (_, _, g)| {
-        (e + 1, b + usize::from(g.len() == 1))
-    });
-    let mut edges = Vec::with_capacity(num_edges);
-    let mut triangle_edges = vec![[NONE; 3]; nt];
     let mut neighbours = vec![[NONE; 3]; nt];
-    let mut boundary_edges = Vec::with_capacity(num_boundary);
+    let (mut num_edges, mut num_boundary_edges) = (0, 0);
     for (a, b, group) in half.groups() {
         if group.len() > 2 {
             return Err(half.non_manifold(&data.vertex_ids, element_id));
         }
-        let e = edges.len() as u32;
-        edges.push([a, b]);
-        if group.len() == 1 {
-            boundary_edges.push(e);
-        }
+        num_edges += 1;
+        num_boundary_edges += usize::from(group.len() == 1);
         let side = |t: u32| side_of(data.triangles[t as usize], a, b);
-        for &(_, t) in group {
-            if (t as usize) < nt {
-                triangle_edges[t as usize][side(t)] = e;
-            }
-        }
         if let [(_, t), (_, u)] = *group {
             let (ti, ui) = (t as usize, u as usize);
             if ti < nt && ui < nt && data.triangle_surface[ti] == data.triangle_surface[ui] {
@@ -319,7 +337,6 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             // Reverse (a, b, c) -> (a, c, b): sides 0 and 2 swap, side 1 reverses in place.
             let [a, b, c] = data.triangles[t];
             data.triangles[t] = [a, c, b];
-            triangle_edges[t].swap(0, 2);
             neighbours[t].swap(0, 2);
         }
     }
@@ -335,11 +352,9 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
         reoriented,
         model: data.model,
         topology: Topology {
-            edges,
-            triangle_edges,
+            num_edges,
             neighbours,
-            boundary_edges,
-            component,
+            num_boundary_edges,
             component_sizes,
         },
     })
@@ -348,18 +363,21 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
 pub(super) fn sanity_check(mesh: &Mesh) -> Result<(), String> {
     let topo = &mesh.topology;
     let nt = mesh.triangles.len();
-    if topo.neighbours.len() != nt || topo.triangle_edges.len() != nt || topo.component.len() != nt
-    {
+    if topo.neighbours.len() != nt {
         return Err("topology arrays do not match the triangle count".into());
     }
     if mesh.triangle_surface.len() != nt || mesh.triangle_ids.len() != nt {
         return Err("per-triangle arrays do not match the triangle count".into());
     }
+    let all = edges(mesh);
+    if all.edges.len() != topo.num_edges || all.boundary_edges.len() != topo.num_boundary_edges {
+        return Err("edge counts do not match the edges".into());
+    }
     for (t, tri) in mesh.triangles.iter().enumerate() {
         for i in 0..3 {
             let (a, b) = (tri[i], tri[(i + 1) % 3]);
-            let e = topo.triangle_edges[t][i];
-            if e as usize >= topo.edges.len() || topo.edges[e as usize] != [a.min(b), a.max(b)] {
+            let e = all.triangle_edges[t][i];
+            if e as usize >= all.edges.len() || all.edges[e as usize] != [a.min(b), a.max(b)] {
                 return Err(format!("triangle {t} side {i}: wrong edge {e}"));
             }
             let u = topo.neighbours[t][i];
@@ -374,7 +392,7 @@ pub(super) fn sanity_check(mesh: &Mesh) -> Result<(), String> {
             let Some(j) = j else {
                 return Err(format!("dual graph not symmetric between {t} and {u}"));
             };
-            if topo.triangle_edges[u][j] != e {
+            if all.triangle_edges[u][j] != e {
                 return Err(format!(
                     "triangles {t} and {u} are neighbours across different edges"
                 ));
@@ -390,24 +408,33 @@ pub(super) fn sanity_check(mesh: &Mesh) -> Result<(), String> {
                     "triangles {t} and {u} are neighbours across surfaces"
                 ));
             }
-            if topo.component[t] != topo.component[u] {
-                return Err(format!("neighbours {t} and {u} in different components"));
+        }
+    }
+    // Components by a walk of the dual graph, numbered by first triangle.
+    let mut component = vec![NONE; nt];
+    let mut sizes = Vec::new();
+    for start in 0..nt {
+        if component[start] != NONE {
+            continue;
+        }
+        let c = sizes.len() as u32;
+        component[start] = c;
+        let (mut size, mut stack) = (0u32, vec![start as u32]);
+        while let Some(t) = stack.pop() {
+            size += 1;
+            for &u in &topo.neighbours[t as usize] {
+                if u != NONE && component[u as usize] == NONE {
+                    component[u as usize] = c;
+                    stack.push(u);
+                }
             }
         }
-    }
-    let mut sizes = vec![0u32; topo.component_sizes.len()];
-    for &c in &topo.component {
-        match sizes.get_mut(c as usize) {
-            Some(s) => *s += 1,
-            None => return Err(format!("component index {c} out of range")),
-        }
+        sizes.push(size);
     }
     if sizes != topo.component_sizes {
-        return Err("component sizes do not match the component labels".into());
+        return Err("component sizes do not match the dual graph's components".into());
     }
-    let mut sorted = topo.edges.clone();
-    sorted.sort_unstable();
-    if sorted.windows(2).any(|w| w[0] == w[1]) || topo.edges.iter().any(|e| e[0] >= e[1]) {
+    if all.edges.windows(2).any(|w| w[0] >= w[1]) || all.edges.iter().any(|e| e[0] >= e[1]) {
         return Err("edges are not unique sorted pairs".into());
     }
     Ok(())
@@ -477,8 +504,11 @@ mod tests {
         let mesh = Mesh::new(square([0, 2, 3])).unwrap();
         mesh.sanity_check().unwrap();
         assert_eq!(mesh.topology.num_dual_edges(), 1);
-        assert_eq!(mesh.topology.boundary_edges.len(), 4);
-        assert_eq!(mesh.topology.edges.len(), 5);
+        assert_eq!(mesh.topology.num_boundary_edges, 4);
+        assert_eq!(mesh.topology.num_edges, 5);
+        let edges = mesh.edges();
+        assert_eq!(edges.edges.len(), 5);
+        assert_eq!(edges.boundary_edges.len(), 4);
         assert_eq!(mesh.topology.component_sizes, vec![2]);
         assert_eq!(mesh.reoriented, 0);
     }
