@@ -106,6 +106,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let t = Instant::now();
     let file = mesh::msh::parse(&src.path, &src.bytes)?;
     let parse = ms(t);
+    // The file's bytes are not needed past the parse: free them before the mesh is built.
+    let src = mesh::Source {
+        bytes: Vec::new().into(),
+        ..src
+    };
     let format = format!(
         "msh {} {}",
         file.version,
@@ -170,7 +175,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         surfaces: m.surfaces().len(),
         components: topo.component_sizes.len(),
         odd_components: topo.component_sizes.iter().filter(|&&s| s % 2 == 1).count(),
-        boundary_edges: topo.boundary_edges.len(),
+        boundary_edges: topo.num_boundary_edges,
         candidate_pairs: table.len(),
         valid_pairs: table
             .eta

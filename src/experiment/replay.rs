@@ -399,7 +399,7 @@ fn load_mesh(
     let loads = places.iter().map(|p| -> Result<_, crate::mesh::ReadError> {
         let src = crate::mesh::source(p)?;
         let file = (!src.builtin).then(|| src.path.clone());
-        Ok((src.mesh()?, file))
+        Ok((src.into_mesh()?, file))
     });
     let (mut first_err, mut other_hash) = (None, None);
     for loaded in loads {
@@ -423,7 +423,7 @@ fn load_mesh(
             builtin: true,
             bytes: bytes.into(),
         };
-        match src.mesh() {
+        match src.into_mesh() {
             Ok(m) if record.mesh_hash.is_empty() || mesh_hash(&m) == record.mesh_hash => {
                 return Ok((m, None));
             }

@@ -85,7 +85,7 @@ pub(crate) fn refine(
     rule: Rule,
 ) -> Result<SheetMesh, SheetError> {
     let nt = mesh.num_triangles();
-    let topo = &mesh.topology;
+    let topo = mesh.edges();
     let leftovers: Vec<u32> = pairing.leftovers().collect();
     let mut is_left = vec![false; nt];
     for &t in &leftovers {

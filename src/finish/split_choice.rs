@@ -127,6 +127,7 @@ impl std::fmt::Display for Stuck {
 /// would each make a quad `rule` allows with the triangle across their inner side.
 pub(crate) fn split_side(
     mesh: &Mesh,
+    triangle_edges: &[[u32; 3]],
     is_boundary: &[bool],
     rule: Rule,
     s: u32,
@@ -146,7 +147,7 @@ pub(crate) fn split_side(
             .find(|&v| v != a && v != b)
     };
     (0..3).find_map(|i| {
-        if nb[i] != NONE || !is_boundary[mesh.topology.triangle_edges[s as usize][i] as usize] {
+        if nb[i] != NONE || !is_boundary[triangle_edges[s as usize][i] as usize] {
             return None;
         }
         let (p, q, o) = (tri[i], tri[(i + 1) % 3], tri[(i + 2) % 3]);
@@ -179,8 +180,9 @@ pub(crate) fn choose(
     regions: &mut usize,
 ) -> Chosen {
     let nt = pairing.cand.len();
-    let mut is_boundary = vec![false; mesh.topology.edges.len()];
-    for &e in &mesh.topology.boundary_edges {
+    let edges = mesh.edges();
+    let mut is_boundary = vec![false; edges.edges.len()];
+    for &e in &edges.boundary_edges {
         is_boundary[e as usize] = true;
     }
     let (component, sizes) = CandidateTable::components(&table.dual_graph());
@@ -260,7 +262,9 @@ pub(crate) fn choose(
         let (mut candidates, mut ruled_out, mut solved) = (0, 0, 0);
         let mut found = None;
         for &s in &order {
-            let Some((side, n1, n2)) = split_side(mesh, &is_boundary, rule, s) else {
+            let Some((side, n1, n2)) =
+                split_side(mesh, &edges.triangle_edges, &is_boundary, rule, s)
+            else {
                 continue;
             };
             if blocked[n1 as usize] || blocked[n2 as usize] {

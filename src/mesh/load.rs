@@ -120,6 +120,12 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
             });
         }
     }
+    // Exactly the file's size: `read_to_end` doubles its buffer as it goes, which left the
+    // buffer up to twice the file (84 bytes per triangle for a 48-byte-per-triangle strip).
+    let rest = usize::try_from(len)
+        .unwrap_or(usize::MAX)
+        .saturating_sub(bytes.len());
+    bytes.reserve_exact(rest);
     reader.read_to_end(&mut bytes).map_err(io)?;
     Ok(bytes)
 }
@@ -127,17 +133,29 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
 impl Source {
     /// Parses and validates the mesh, its elements in spatial order ([`order::spatial`]: the
     /// searches run faster on it; node and element tags are kept).
+    /// Keeps the bytes; [`Source::into_mesh`] frees them before the mesh is built.
     pub fn mesh(&self) -> Result<Mesh, ReadError> {
         let mut file = msh::parse(&self.path, &self.bytes)?;
         order::spatial(&mut file.data);
         file.into_mesh(&self.path)
+    }
+
+    /// As [`Source::mesh`], but the file's bytes are freed as soon as they are parsed, before
+    /// the spatial order and the topology are built (they were the largest part of the
+    /// load's peak memory: the whole file, alive until the mesh was done).
+    pub fn into_mesh(self) -> Result<Mesh, ReadError> {
+        let Source { path, bytes, .. } = self;
+        let mut file = msh::parse(&path, &bytes)?;
+        drop(bytes);
+        order::spatial(&mut file.data);
+        file.into_mesh(&path)
     }
 }
 
 /// Loads a mesh given as a file path or the name of a built-in case (see
 /// [`builtin::NAMES`]). A path that exists wins over a built-in of the same name.
 pub fn load(spec: &str) -> Result<Mesh, ReadError> {
-    source(spec)?.mesh()
+    source(spec)?.into_mesh()
 }
 
 /// What a file is, for messages: "a directory", "a FIFO (named pipe)", ...

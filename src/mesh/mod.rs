@@ -5,6 +5,8 @@ pub mod builtin;
 mod error;
 pub mod generate;
 mod load;
+#[cfg(test)]
+mod load_memory;
 pub mod msh;
 pub mod order;
 pub mod suite;
@@ -14,7 +16,7 @@ pub mod vtu;
 pub use load::{Source, file_kind, load, read_file, source};
 
 pub use error::{MeshError, ReadError};
-pub use topology::Topology;
+pub use topology::{Edges, Topology};
 
 /// Marker for "no triangle / no candidate" in `u32` index arrays.
 pub const NONE: u32 = u32::MAX;
@@ -45,7 +47,8 @@ pub struct Mesh {
     /// point and line elements), which the MSH writer writes back; `None` for generated
     /// meshes.
     pub model: Option<Box<msh::Model>>,
-    /// Edges, dual graph, boundary and components.
+    /// Dual graph, numbers of edges and boundary edges, components (the edges themselves:
+    /// [`Mesh::edges`]).
     pub topology: Topology,
 }
 
@@ -174,6 +177,13 @@ impl Mesh {
     /// Distinct surface tags, sorted.
     pub fn surfaces(&self) -> Vec<i32> {
         distinct_surfaces(&self.triangle_surface, &self.quad_surface)
+    }
+
+    /// The unique edges, each triangle side's edge and the boundary edges, computed (`O(n)`,
+    /// 24 to 32 bytes per triangle): the mesh does not keep them, the searches never read
+    /// them.
+    pub fn edges(&self) -> Edges {
+        topology::edges(self)
     }
 
     /// Checks every invariant of the mesh and its topology; returns the first violation.

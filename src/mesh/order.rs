@@ -49,6 +49,11 @@ pub fn spatial(data: &mut MeshData) {
     let mut order: Vec<u32> = (0..nt as u32).collect();
     let keys: Vec<u64> = data.triangles.iter().map(key).collect();
     order.sort_by_key(|&t| keys[t as usize]);
+    drop(keys);
+    // A gather into a new array, the old one dropped before the next: one array's copy at a
+    // time. (Permuting in place along the cycles needs no copy, but its chained random
+    // reads made the spatial order three times slower on a 10^6-triangle strip, and the
+    // copy is not the load's peak: the topology's build is.)
     fn permute<T: Copy>(v: &mut Vec<T>, order: &[u32]) {
         let old = std::mem::take(v);
         *v = order.iter().map(|&t| old[t as usize]).collect();
@@ -56,6 +61,7 @@ pub fn spatial(data: &mut MeshData) {
     permute(&mut data.triangles, &order);
     permute(&mut data.triangle_ids, &order);
     permute(&mut data.triangle_surface, &order);
+    drop(order);
     // Vertices by first use (triangles, then quads, then unused ones); out-of-range indices
     // are left for validation to report.
     let mut new_index = vec![u32::MAX; nv];

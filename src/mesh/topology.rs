@@ -1,29 +1,62 @@
-//! Topology built once from validated mesh data: unique edges, the dual graph (neighbours
-//! across each triangle side, same surface only), boundary edges and connected components.
-//! Also validation and consistent re-orientation of the input. Knows no geometry except the
-//! zero-area test.
+//! Topology built once from validated mesh data: the dual graph (neighbours across each
+//! triangle side, same surface only), the numbers of edges and boundary edges, and the
+//! connected components; the edges themselves on demand ([`Edges`]). Also validation and
+//! consistent re-orientation of the input. Knows no geometry except the zero-area test.
 
 use super::{Mesh, MeshData, MeshError, NONE};
 
-/// Edges, dual graph and components of a [`Mesh`].
+/// Dual graph and components of a [`Mesh`], kept for its life (the edges, which the
+/// searches never read, are computed when asked for: [`Mesh::edges`]).
 ///
 /// Side `i` of triangle `t` is the edge from `triangles[t][i]` to `triangles[t][(i + 1) % 3]`.
 #[derive(Debug, Clone, Default)]
 pub struct Topology {
+    /// Dual graph: the triangle across each side, or [`NONE`] on a boundary, next to a quad,
+    /// or across a surface boundary.
+    pub neighbours: Vec<[u32; 3]>,
+    /// Number of unique edges, over triangles and input quads.
+    pub num_edges: usize,
+    /// Number of edges used by exactly one element (triangle or quad).
+    pub num_boundary_edges: usize,
+    /// Number of triangles in each connected component of the dual graph, the components
+    /// numbered in order of their first triangle.
+    pub component_sizes: Vec<u32>,
+}
+
+/// The edges of a [`Mesh`] ([`Mesh::edges`]), numbered in increasing vertex pair.
+#[derive(Debug, Clone, Default)]
+pub struct Edges {
     /// Unique edges as sorted vertex pairs, over triangles and input quads.
     pub edges: Vec<[u32; 2]>,
     /// Edge index of each triangle side.
     pub triangle_edges: Vec<[u32; 3]>,
-    /// Dual graph: the triangle across each side, or [`NONE`] on a boundary, next to a quad,
-    /// or across a surface boundary.
-    pub neighbours: Vec<[u32; 3]>,
     /// Edges used by exactly one element (triangle or quad).
     pub boundary_edges: Vec<u32>,
-    /// Connected component (of the dual graph) of each triangle, numbered in order of first
-    /// triangle.
-    pub component: Vec<u32>,
-    /// Number of triangles in each component.
-    pub component_sizes: Vec<u32>,
+}
+
+/// The edges of `mesh` (see [`Edges`]).
+pub(super) fn edges(mesh: &Mesh) -> Edges {
+    let nt = mesh.triangles.len();
+    let half = HalfEdges::new(mesh.vertices.len(), &mesh.triangles, &mesh.quads)
+        .expect("a built mesh's sides fit in u32");
+    let mut out = Edges {
+        edges: Vec::with_capacity(mesh.topology.num_edges),
+        triangle_edges: vec![[NONE; 3]; nt],
+        boundary_edges: Vec::with_capacity(mesh.topology.num_boundary_edges),
+    };
+    for (a, b, group) in half.groups() {
+        let e = out.edges.len() as u32;
+        out.edges.push([a, b]);
+        if group.len() == 1 {
+            out.boundary_edges.push(e);
+        }
+        for &(_, t) in group {
+            if let Some(&tri) = mesh.triangles.get(t as usize) {
+                out.triangle_edges[t as usize][side_of(tri, a, b)] = e;
+            }
+        }
+    }
+    out
 }
 
 impl Topology {
@@ -37,38 +70,137 @@ impl Topology {
     }
 }
 
-/// The error for a mesh with non-manifold edges, the same whatever the order of the nodes
-/// and elements (the file's, or the spatial order of a loaded mesh): the edge with the
-/// smallest node tags, its nodes in increasing tag, its first elements in increasing tag.
-/// `half`: sorted half-edges `(a, b, element, ...)` as in [`build`].
-fn non_manifold<T>(
-    half: &[(u32, u32, u32, T)],
-    vertex_ids: &[u64],
-    element_id: impl Fn(u32) -> u64,
-) -> MeshError {
-    let mut worst: Option<(u64, u64, Vec<u64>)> = None;
-    for group in half.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-        if group.len() <= 2 {
-            continue;
+/// Every element's sides (half-edges), grouped by edge: a counting sort on the smaller
+/// vertex, each vertex's list sorted by (larger vertex, element), the order of a sort of
+/// `(min, max, element)` tuples in 8 bytes per half-edge and 4 per vertex (the tuples and
+/// their sort took 16 per half-edge, the topology build's peak). Elements `nt..` are the
+/// quads.
+struct HalfEdges {
+    /// `start[a]..start[a + 1]`: the entries of the sides whose smaller vertex is `a`.
+    start: Vec<u32>,
+    /// (larger vertex, element) of each side.
+    entries: Vec<(u32, u32)>,
+}
+
+impl HalfEdges {
+    /// The sides of `data`'s triangles and quads (node indices checked); the mesh is too
+    /// large when they do not fit in `u32` indices.
+    fn new(nv: usize, triangles: &[[u32; 3]], quads: &[[u32; 4]]) -> Result<HalfEdges, MeshError> {
+        let nt = triangles.len();
+        let count = 3 * nt as u64 + 4 * quads.len() as u64;
+        if count >= u64::from(NONE) {
+            return Err(MeshError::TooLarge {
+                vertices: nv,
+                triangles: nt,
+            });
         }
-        let (ta, tb) = (
-            vertex_ids[group[0].0 as usize],
-            vertex_ids[group[0].1 as usize],
-        );
-        let key = (ta.min(tb), ta.max(tb));
-        if worst.as_ref().is_none_or(|w| key < (w.0, w.1)) {
-            let mut elements: Vec<u64> = group.iter().map(|h| element_id(h.2)).collect();
-            elements.sort_unstable();
-            worst = Some((key.0, key.1, elements));
+        let sides = || {
+            let tris = triangles.iter().flat_map(|t| {
+                (0..3).map(move |i| (t[i].min(t[(i + 1) % 3]), t[i].max(t[(i + 1) % 3])))
+            });
+            let quads = quads.iter().flat_map(|q| {
+                (0..4).map(move |i| (q[i].min(q[(i + 1) % 4]), q[i].max(q[(i + 1) % 4])))
+            });
+            tris.chain(quads)
+        };
+        let mut start = vec![0u32; nv + 1];
+        for (a, _) in sides() {
+            start[a as usize + 1] += 1;
+        }
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        // Filled with start[a] as the cursor; it ends at the next list's start.
+        let mut entries = vec![(0u32, 0u32); count as usize];
+        for (k, (a, b)) in sides().enumerate() {
+            let element = if k < 3 * nt {
+                k / 3
+            } else {
+                nt + (k - 3 * nt) / 4
+            };
+            let slot = &mut start[a as usize];
+            entries[*slot as usize] = (b, element as u32);
+            *slot += 1;
+        }
+        start.copy_within(0..nv, 1);
+        start[0] = 0;
+        for v in 0..nv {
+            entries[start[v] as usize..start[v + 1] as usize].sort_unstable();
+        }
+        Ok(HalfEdges { start, entries })
+    }
+
+    /// The edges in increasing (smaller vertex, larger vertex): each with the
+    /// (larger vertex, element) of its sides, elements increasing.
+    fn groups(&self) -> impl Iterator<Item = (u32, u32, &[(u32, u32)])> {
+        self.start.windows(2).enumerate().flat_map(move |(a, w)| {
+            self.entries[w[0] as usize..w[1] as usize]
+                .chunk_by(|x, y| x.0 == y.0)
+                .map(move |g| (a as u32, g[0].0, g))
+        })
+    }
+
+    /// Two triangles with the same three vertices, if any: of the smallest sorted vertex
+    /// triple, its first two triangles (in index order).
+    fn duplicate_triangle(&self, triangles: &[[u32; 3]]) -> Option<(u32, u32)> {
+        let mut third: Vec<(u32, u32)> = Vec::new();
+        for (a, b, group) in self.groups() {
+            if group.len() < 2 {
+                continue;
+            }
+            // The triangles whose two smallest vertices are a and b, by their third.
+            third.clear();
+            third.extend(group.iter().filter_map(|&(_, t)| {
+                let c = triangles
+                    .get(t as usize)?
+                    .iter()
+                    .find(|&&v| v != a && v != b)?;
+                (*c > b).then_some((*c, t))
+            }));
+            third.sort_unstable();
+            if let Some(w) = third.windows(2).find(|w| w[0].0 == w[1].0) {
+                return Some((w[0].1, w[1].1));
+            }
+        }
+        None
+    }
+
+    /// The error for a mesh with non-manifold edges, the same whatever the order of the
+    /// nodes and elements (the file's, or the spatial order of a loaded mesh): the edge
+    /// with the smallest node tags, its nodes in increasing tag, its first elements in
+    /// increasing tag.
+    fn non_manifold(&self, vertex_ids: &[u64], element_id: impl Fn(u32) -> u64) -> MeshError {
+        let mut worst: Option<(u64, u64, Vec<u64>)> = None;
+        for (a, b, group) in self.groups() {
+            if group.len() <= 2 {
+                continue;
+            }
+            let (ta, tb) = (vertex_ids[a as usize], vertex_ids[b as usize]);
+            let key = (ta.min(tb), ta.max(tb));
+            if worst.as_ref().is_none_or(|w| key < (w.0, w.1)) {
+                let mut elements: Vec<u64> = group.iter().map(|h| element_id(h.1)).collect();
+                elements.sort_unstable();
+                worst = Some((key.0, key.1, elements));
+            }
+        }
+        let (a, b, elements) = worst.expect("a non-manifold edge");
+        MeshError::NonManifoldEdge {
+            a,
+            b,
+            count: elements.len(),
+            elements: elements.into_iter().take(4).collect(),
         }
     }
-    let (a, b, elements) = worst.expect("a non-manifold edge");
-    MeshError::NonManifoldEdge {
-        a,
-        b,
-        count: elements.len(),
-        elements: elements.into_iter().take(4).collect(),
-    }
+}
+
+/// The side of triangle `tri` whose ends are `a` and `b` (in either direction).
+fn side_of(tri: [u32; 3], a: u32, b: u32) -> usize {
+    (0..3)
+        .find(|&i| {
+            let (u, v) = (tri[i], tri[(i + 1) % 3]);
+            (u == a && v == b) || (u == b && v == a)
+        })
+        .expect("a side of the triangle")
 }
 
 /// Validates `data` and builds the mesh with its topology.
@@ -109,42 +241,13 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             });
         }
     }
-    // Duplicate triangles: same vertex set.
-    let mut keys: Vec<([u32; 3], u32)> = data
-        .triangles
-        .iter()
-        .enumerate()
-        .map(|(t, tri)| {
-            let mut k = *tri;
-            k.sort_unstable();
-            (k, t as u32)
-        })
-        .collect();
-    keys.sort_unstable();
-    for w in keys.windows(2) {
-        if w[0].0 == w[1].0 {
-            return Err(MeshError::DuplicateTriangle {
-                element: data.triangle_ids[w[1].1 as usize],
-                first: data.triangle_ids[w[0].1 as usize],
-            });
-        }
+    let half = HalfEdges::new(nv, &data.triangles, &data.quads)?;
+    if let Some((first, second)) = half.duplicate_triangle(&data.triangles) {
+        return Err(MeshError::DuplicateTriangle {
+            element: data.triangle_ids[second as usize],
+            first: data.triangle_ids[first as usize],
+        });
     }
-
-    // Half-edges of every element: (min, max, element, side). Quads are elements nt.. .
-    let mut half: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * nt + 4 * data.quads.len());
-    for (t, tri) in data.triangles.iter().enumerate() {
-        for i in 0..3 {
-            let (a, b) = (tri[i], tri[(i + 1) % 3]);
-            half.push((a.min(b), a.max(b), t as u32, i as u8));
-        }
-    }
-    for (q, quad) in data.quads.iter().enumerate() {
-        for i in 0..4 {
-            let (a, b) = (quad[i], quad[(i + 1) % 4]);
-            half.push((a.min(b), a.max(b), (nt + q) as u32, i as u8));
-        }
-    }
-    half.sort_unstable();
 
     let element_id = |e: u32| -> u64 {
         let e = e as usize;
@@ -154,45 +257,24 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             data.quad_ids[e - nt]
         }
     };
-    let mut edges = Vec::with_capacity(half.len() / 2 + 16);
-    let mut triangle_edges = vec![[NONE; 3]; nt];
     let mut neighbours = vec![[NONE; 3]; nt];
-    let mut boundary_edges = Vec::new();
-    // Pairs of triangles (t, side, u, side) on the same surface sharing an edge.
-    let mut links: Vec<(u32, u8, u32, u8)> = Vec::new();
-    let mut i = 0;
-    while i < half.len() {
-        let (a, b) = (half[i].0, half[i].1);
-        let mut j = i + 1;
-        while j < half.len() && half[j].0 == a && half[j].1 == b {
-            j += 1;
-        }
-        let group = &half[i..j];
+    let (mut num_edges, mut num_boundary_edges) = (0, 0);
+    for (a, b, group) in half.groups() {
         if group.len() > 2 {
-            return Err(non_manifold(&half, &data.vertex_ids, element_id));
+            return Err(half.non_manifold(&data.vertex_ids, element_id));
         }
-        let e = edges.len() as u32;
-        edges.push([a, b]);
-        if group.len() == 1 {
-            boundary_edges.push(e);
-        }
-        for h in group {
-            if (h.2 as usize) < nt {
-                triangle_edges[h.2 as usize][h.3 as usize] = e;
+        num_edges += 1;
+        num_boundary_edges += usize::from(group.len() == 1);
+        let side = |t: u32| side_of(data.triangles[t as usize], a, b);
+        if let [(_, t), (_, u)] = *group {
+            let (ti, ui) = (t as usize, u as usize);
+            if ti < nt && ui < nt && data.triangle_surface[ti] == data.triangle_surface[ui] {
+                neighbours[ti][side(t)] = u;
+                neighbours[ui][side(u)] = t;
             }
         }
-        if let [h0, h1] = group {
-            let (t, u) = (h0.2 as usize, h1.2 as usize);
-            if t < nt && u < nt && data.triangle_surface[t] == data.triangle_surface[u] {
-                links.push((h0.2, h0.3, h1.2, h1.3));
-            }
-        }
-        i = j;
     }
-    for &(t, si, u, sj) in &links {
-        neighbours[t as usize][si as usize] = u;
-        neighbours[u as usize][sj as usize] = t;
-    }
+    drop(half);
 
     // Components, and consistent orientation within each (flip[t] = reverse t).
     let mut component = vec![NONE; nt];
@@ -255,7 +337,6 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             // Reverse (a, b, c) -> (a, c, b): sides 0 and 2 swap, side 1 reverses in place.
             let [a, b, c] = data.triangles[t];
             data.triangles[t] = [a, c, b];
-            triangle_edges[t].swap(0, 2);
             neighbours[t].swap(0, 2);
         }
     }
@@ -271,11 +352,9 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
         reoriented,
         model: data.model,
         topology: Topology {
-            edges,
-            triangle_edges,
+            num_edges,
             neighbours,
-            boundary_edges,
-            component,
+            num_boundary_edges,
             component_sizes,
         },
     })
@@ -284,18 +363,21 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
 pub(super) fn sanity_check(mesh: &Mesh) -> Result<(), String> {
     let topo = &mesh.topology;
     let nt = mesh.triangles.len();
-    if topo.neighbours.len() != nt || topo.triangle_edges.len() != nt || topo.component.len() != nt
-    {
+    if topo.neighbours.len() != nt {
         return Err("topology arrays do not match the triangle count".into());
     }
     if mesh.triangle_surface.len() != nt || mesh.triangle_ids.len() != nt {
         return Err("per-triangle arrays do not match the triangle count".into());
     }
+    let all = edges(mesh);
+    if all.edges.len() != topo.num_edges || all.boundary_edges.len() != topo.num_boundary_edges {
+        return Err("edge counts do not match the edges".into());
+    }
     for (t, tri) in mesh.triangles.iter().enumerate() {
         for i in 0..3 {
             let (a, b) = (tri[i], tri[(i + 1) % 3]);
-            let e = topo.triangle_edges[t][i];
-            if e as usize >= topo.edges.len() || topo.edges[e as usize] != [a.min(b), a.max(b)] {
+            let e = all.triangle_edges[t][i];
+            if e as usize >= all.edges.len() || all.edges[e as usize] != [a.min(b), a.max(b)] {
                 return Err(format!("triangle {t} side {i}: wrong edge {e}"));
             }
             let u = topo.neighbours[t][i];
@@ -310,7 +392,7 @@ pub(super) fn sanity_check(mesh: &Mesh) -> Result<(), String> {
             let Some(j) = j else {
                 return Err(format!("dual graph not symmetric between {t} and {u}"));
             };
-            if topo.triangle_edges[u][j] != e {
+            if all.triangle_edges[u][j] != e {
                 return Err(format!(
                     "triangles {t} and {u} are neighbours across different edges"
                 ));
@@ -326,24 +408,33 @@ pub(super) fn sanity_check(mesh: &Mesh) -> Result<(), String> {
                     "triangles {t} and {u} are neighbours across surfaces"
                 ));
             }
-            if topo.component[t] != topo.component[u] {
-                return Err(format!("neighbours {t} and {u} in different components"));
+        }
+    }
+    // Components by a walk of the dual graph, numbered by first triangle.
+    let mut component = vec![NONE; nt];
+    let mut sizes = Vec::new();
+    for start in 0..nt {
+        if component[start] != NONE {
+            continue;
+        }
+        let c = sizes.len() as u32;
+        component[start] = c;
+        let (mut size, mut stack) = (0u32, vec![start as u32]);
+        while let Some(t) = stack.pop() {
+            size += 1;
+            for &u in &topo.neighbours[t as usize] {
+                if u != NONE && component[u as usize] == NONE {
+                    component[u as usize] = c;
+                    stack.push(u);
+                }
             }
         }
-    }
-    let mut sizes = vec![0u32; topo.component_sizes.len()];
-    for &c in &topo.component {
-        match sizes.get_mut(c as usize) {
-            Some(s) => *s += 1,
-            None => return Err(format!("component index {c} out of range")),
-        }
+        sizes.push(size);
     }
     if sizes != topo.component_sizes {
-        return Err("component sizes do not match the component labels".into());
+        return Err("component sizes do not match the dual graph's components".into());
     }
-    let mut sorted = topo.edges.clone();
-    sorted.sort_unstable();
-    if sorted.windows(2).any(|w| w[0] == w[1]) || topo.edges.iter().any(|e| e[0] >= e[1]) {
+    if all.edges.windows(2).any(|w| w[0] >= w[1]) || all.edges.iter().any(|e| e[0] >= e[1]) {
         return Err("edges are not unique sorted pairs".into());
     }
     Ok(())
@@ -413,8 +504,11 @@ mod tests {
         let mesh = Mesh::new(square([0, 2, 3])).unwrap();
         mesh.sanity_check().unwrap();
         assert_eq!(mesh.topology.num_dual_edges(), 1);
-        assert_eq!(mesh.topology.boundary_edges.len(), 4);
-        assert_eq!(mesh.topology.edges.len(), 5);
+        assert_eq!(mesh.topology.num_boundary_edges, 4);
+        assert_eq!(mesh.topology.num_edges, 5);
+        let edges = mesh.edges();
+        assert_eq!(edges.edges.len(), 5);
+        assert_eq!(edges.boundary_edges.len(), 4);
         assert_eq!(mesh.topology.component_sizes, vec![2]);
         assert_eq!(mesh.reoriented, 0);
     }

@@ -146,7 +146,7 @@ impl View {
         let up = cross(toward_viewer, right);
         // A closed surface (no boundary edge) has a signed volume whose sign says whether the
         // consistent orientation points outward.
-        let closed = mesh.topology.boundary_edges.is_empty();
+        let closed = mesh.topology.num_boundary_edges == 0;
         let outward = if closed {
             let vol: f64 = mesh
                 .triangles

@@ -713,7 +713,7 @@ fn info_reports_counts_and_eta_statistics() {
     assert_eq!(v["surfaces"], 2);
     assert_eq!(v["components"], 2);
     assert_eq!(v["format"], "msh 4.1 ascii");
-    assert_eq!(v["boundary_edges"], m.topology.boundary_edges.len());
+    assert_eq!(v["boundary_edges"], m.topology.num_boundary_edges);
     assert_eq!(v["candidate_pairs"], table.len());
     let hist: u64 = v["eta"]["histogram"]
         .as_array()

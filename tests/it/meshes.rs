@@ -11,7 +11,7 @@ use std::collections::HashSet;
 /// V - E + F over the triangles.
 fn euler(mesh: &Mesh) -> i64 {
     let used: HashSet<u32> = mesh.triangles.iter().flatten().copied().collect();
-    used.len() as i64 - mesh.topology.edges.len() as i64 + mesh.num_triangles() as i64
+    used.len() as i64 - mesh.topology.num_edges as i64 + mesh.num_triangles() as i64
 }
 
 fn checked(mesh: Mesh) -> Mesh {
@@ -149,7 +149,7 @@ fn builtin_meshes_load_by_name() {
             "{name}"
         );
         assert_eq!(euler(&mesh), euler_characteristic, "{name}");
-        assert_eq!(!mesh.topology.boundary_edges.is_empty(), boundary, "{name}");
+        assert_eq!((mesh.topology.num_boundary_edges > 0), boundary, "{name}");
     }
     // From another directory, through the CLI.
     let dir = tempfile::tempdir().unwrap();
@@ -180,7 +180,7 @@ fn grid_counts_topology_and_geometry() {
             vec![mesh.num_triangles() as u32]
         );
         assert_eq!(mesh.surfaces(), vec![1]);
-        assert_eq!(mesh.topology.boundary_edges.len(), 2 * (nx + ny));
+        assert_eq!(mesh.topology.num_boundary_edges, 2 * (nx + ny));
         assert_eq!(euler(&mesh), 1, "a disk");
         for v in &mesh.vertices {
             assert!((0.0..=1.0).contains(&v[0]) && (0.0..=1.0).contains(&v[1]) && v[2] == 0.0);
@@ -272,8 +272,9 @@ fn grid_jitter_keeps_the_boundary_and_moves_the_interior() {
         off >= interior,
         "{off} of {interior} interior vertices moved"
     );
-    for &e in &moved.topology.boundary_edges {
-        for v in moved.topology.edges[e as usize] {
+    let edges = moved.edges();
+    for &e in &edges.boundary_edges {
+        for v in edges.edges[e as usize] {
             let [x, y, _] = moved.vertices[v as usize];
             assert!(
                 x == 0.0 || x == 1.0 || y == 0.0 || y == 1.0,
@@ -311,7 +312,7 @@ fn grid_with_hole() {
     assert_eq!(mesh.topology.component_sizes.len(), 1);
     assert_eq!(euler(&mesh), 0, "an annulus");
     assert_eq!(
-        mesh.topology.boundary_edges.len(),
+        mesh.topology.num_boundary_edges,
         2 * (nx + ny) + 2 * (hx + hy)
     );
     // No vertex left inside the hole.
@@ -354,7 +355,7 @@ fn grid_with_surfaces_splits_the_dual_graph() {
             }
         }
         // The interface edges are shared (not boundary) but not dual edges.
-        assert_eq!(mesh.topology.boundary_edges.len(), 2 * (nx + ny));
+        assert_eq!(mesh.topology.num_boundary_edges, 2 * (nx + ny));
         let dual_edges = 3 * mesh.num_triangles() - 2 * (nx + ny);
         assert_eq!(
             mesh.topology.num_dual_edges(),
@@ -513,7 +514,7 @@ fn icosphere_is_a_closed_outward_unit_sphere() {
         let n = 20 * 4usize.pow(s);
         assert_eq!(mesh.num_triangles(), n);
         assert_eq!(mesh.vertices.len(), 10 * 4usize.pow(s) + 2);
-        assert!(mesh.topology.boundary_edges.is_empty());
+        assert!((mesh.topology.num_boundary_edges == 0));
         assert!(
             mesh.topology
                 .neighbours

@@ -148,7 +148,9 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
 /// Reads and validates a MSH file.
 pub fn read(path: &Path) -> Result<Mesh, ReadError> {
     let bytes = crate::mesh::load::read_file(path)?;
-    parse(path, &bytes)?.into_mesh(path)
+    let file = parse(path, &bytes)?;
+    drop(bytes);
+    file.into_mesh(path)
 }
 
 /// Reads and validates MSH content held in memory; `name` stands for the file in errors.
