@@ -440,9 +440,10 @@ impl State<'_> {
         v
     }
 
-    /// Joins the dead components of `a` and `b` (logged); returns the root that was attached
+    /// Joins the dead components of `a` and `b` (logged inside a look-ahead tree, `tree`,
+    /// else as a base change: [`State::shared_log`]); returns the root that was attached
     /// under the other, if they were distinct.
-    pub(super) fn union(&mut self, a: u32, b: u32) -> Option<u32> {
+    pub(super) fn union(&mut self, a: u32, b: u32, tree: bool) -> Option<u32> {
         let (mut ra, mut rb) = (self.find(a), self.find(b));
         if ra == rb {
             return None;
@@ -452,10 +453,13 @@ impl State<'_> {
         }
         self.dsu_parent[rb as usize] = ra;
         self.dsu_size[ra as usize] += self.dsu_size[rb as usize];
-        self.log.push(Op::Union {
-            child: rb,
-            root: ra,
-        });
+        self.shared_log(
+            Op::Union {
+                child: rb,
+                root: ra,
+            },
+            tree,
+        );
         Some(rb)
     }
 
@@ -466,10 +470,10 @@ impl State<'_> {
     }
 
     /// After a [`State::check`] that found a split of the polder of `t0`: gives each
-    /// finished part a new polder id (logged) and the rest (the running part, or the largest
+    /// finished part a new polder id (logged as [`State::union`] is) and the rest (the running part, or the largest
     /// when all finished) the old id with its new size. The ids whose size changed parity
     /// are left in `changed`.
-    pub(super) fn relabel_split(&mut self, t0: u32) {
+    pub(super) fn relabel_split(&mut self, t0: u32, tree: bool) {
         let p = self.polder[t0 as usize];
         let psize = self.polder_size[p as usize];
         let ns = self.nsearch;
@@ -496,7 +500,7 @@ impl State<'_> {
             }
             let id = self.polder_size.len() as u32;
             self.polder_size.push(gsize[g]);
-            self.log.push(Op::PolderNew);
+            self.shared_log(Op::PolderNew, tree);
             known += gsize[g];
             if gsize[g] % 2 != psize % 2 {
                 self.changed.push(id);
@@ -507,7 +511,7 @@ impl State<'_> {
                 }
                 for i in 0..self.queue[s].len() {
                     let t = self.queue[s][i];
-                    self.log.push(Op::Polder { t, old: p });
+                    self.shared_log(Op::Polder { t, old: p }, tree);
                     self.polder[t as usize] = id;
                 }
             }
@@ -516,7 +520,7 @@ impl State<'_> {
         if rest % 2 != psize % 2 {
             self.changed.push(p);
         }
-        self.log.push(Op::PolderSize { p, old: psize });
+        self.shared_log(Op::PolderSize { p, old: psize }, tree);
         self.polder_size[p as usize] = rest;
     }
 }

@@ -70,8 +70,14 @@ use crate::quality::CandidateTable;
 pub use audit::{TreeAudit, TreeEvent, TreeView};
 pub use oracle::naive_allowed;
 use pk::OrderedSets;
+use thin_vec::ThinVec;
 pub use tree::Near;
 use tree::Overlay;
+
+/// A watch list: the verdicts `(candidate, version)` whose certificate holds an element.
+/// One pointer (8 bytes; an empty list allocates nothing), where a `Vec` took 24 bytes per
+/// triangle and per vertex, most of them empty or short.
+type WatchList = ThinVec<(u32, u32)>;
 
 /// How a verdict was reached (what it depends on).
 const KIND_LOCAL: u8 = 0;
@@ -258,13 +264,13 @@ pub struct State<'a> {
     dead_count: Vec<u32>,
     polder: Vec<u32>,
     polder_size: Vec<u32>,
-    watch: Vec<Vec<(u32, u32)>>,
+    watch: Vec<WatchList>,
     /// Union-find (by size, no path compression, so it can be undone) over vertices: the
     /// connected pieces of the removed region (used triangles, boundaries, input quads).
     dsu_parent: Vec<u32>,
     dsu_size: Vec<u32>,
     /// Verdicts that rely on a dead-component root staying a root.
-    root_watch: Vec<Vec<(u32, u32)>>,
+    root_watch: Vec<WatchList>,
     arc_roots: [u32; 4],
     narcs: usize,
     split: Vec<u32>,

@@ -363,7 +363,7 @@ impl State<'_> {
             let inherited = self.tree.changed.contains(&p);
             let first_new = self.polder_size.len() as u32;
             self.changed.clear();
-            self.relabel_split(t0);
+            self.relabel_split(t0, true);
             self.tree.changed.extend_from_slice(&self.changed);
             if inherited {
                 let tr = &mut self.tree;
@@ -385,7 +385,7 @@ impl State<'_> {
         self.remaining -= 2;
         let q = self.cand[ci].quad;
         for i in 1..4 {
-            self.union(q[0], q[i]);
+            self.union(q[0], q[i], true);
         }
         let tr = &mut self.tree;
         tr.next_serial += 1;

@@ -2,8 +2,11 @@
 //! every change as an [`Op`], `undo` reverts the last action in O(1) per change, `reset`
 //! returns to the initial state.
 
-use super::{DEAD, Initial, KIND_DISTINCT, KIND_LOCAL, Op, State, is_split};
+use super::{DEAD, Initial, KIND_DISTINCT, KIND_LOCAL, Op, State, WatchList, is_split};
 use crate::mesh::NONE;
+
+/// Capacity of the change log kept across forward-mode actions (ops; 28 bytes each).
+const LOG_KEEP: usize = 1 << 12;
 
 impl State<'_> {
     /// Recombines the two triangles of candidate `c` (both must remain; the criterion is
@@ -63,14 +66,16 @@ impl State<'_> {
         }
         self.attached.clear();
         if self.forward {
-            // Nothing will be undone: the log only serves the trees.
+            // Nothing will be undone: the log only serves the trees, whose splits can have
+            // logged a large part; its capacity goes back.
             self.log.clear();
+            self.log.shrink_to(LOG_KEEP);
         } else {
             self.log.push(Op::Apply(c));
         }
         self.changed.clear();
         if split {
-            self.relabel_split(t0);
+            self.relabel_split(t0, false);
         } else {
             let p = self.polder[t0 as usize];
             let psize = self.polder_size[p as usize];
@@ -113,7 +118,7 @@ impl State<'_> {
         // The quad joins the dead components at its four vertices.
         let qv = self.cand[ci].quad;
         for i in 1..4 {
-            if let Some(child) = self.union(qv[0], qv[i]) {
+            if let Some(child) = self.union(qv[0], qv[i], false) {
                 if distinct {
                     self.attached.push(child);
                 }
@@ -126,7 +131,7 @@ impl State<'_> {
                 // A root attached stays attached until a reset; without one (no initial
                 // copy), its list is never read again.
                 if self.forward && self.initial.is_none() {
-                    self.root_watch[child as usize] = Vec::new();
+                    self.root_watch[child as usize] = WatchList::new();
                 }
             }
         }

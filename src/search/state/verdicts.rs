@@ -2,7 +2,10 @@
 //! certificate (watches, split shrinking), the base certificate log, the counts per
 //! triangle and bucket, stale marks and their lazy resolution.
 
-use super::{KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict, is_split};
+use super::{
+    CandRecord, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict, WatchList,
+    is_split,
+};
 use crate::mesh::NONE;
 
 impl State<'_> {
@@ -51,9 +54,7 @@ impl State<'_> {
         }
         if r.kind == KIND_DISTINCT {
             for i in 0..self.narcs {
-                let root = self.arc_roots[i];
-                self.root_watch[root as usize].push((c, ver));
-                self.base_log(Op::RootWatch(root));
+                self.root_watch_push(self.arc_roots[i], c, ver);
             }
         } else if r.kind != KIND_LOCAL {
             for s in 0..self.nsearch {
@@ -64,9 +65,7 @@ impl State<'_> {
             }
             // Linked groups: every arc's root must stay a root.
             for i in 0..self.narcs {
-                let root = self.arc_roots[i];
-                self.root_watch[root as usize].push((c, ver));
-                self.base_log(Op::RootWatch(root));
+                self.root_watch_push(self.arc_roots[i], c, ver);
             }
         }
         let in_split = self.split_pos[ci] != NONE;
@@ -352,26 +351,43 @@ impl State<'_> {
         }
     }
 
+    /// Logs a change that base applies and tree pushes share (polders, dead components):
+    /// always inside a look-ahead tree (`tree`), which undoes its pushes, else as
+    /// [`State::base_log`] (forward mode logs nothing: a relabelled part cost one entry per
+    /// triangle, and the log kept the capacity of the largest).
+    #[inline]
+    pub(super) fn shared_log(&mut self, op: Op, tree: bool) {
+        if tree {
+            self.log.push(op);
+        } else {
+            self.base_log(op);
+        }
+    }
+
     /// Adds `(c, ver)` to the watch list of triangle `t` (logged). In forward mode, where
     /// nothing is undone, a list that doubled is first cleared of the entries of verdicts
     /// since recomputed (those past the initial state's, which a reset brings back).
     fn watch_push(&mut self, t: u32, c: u32, ver: u32) {
-        let list = &mut self.watch[t as usize];
-        if self.forward && list.len() >= 4 && list.len().is_power_of_two() {
-            let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]) as usize;
-            let cand = &self.cand;
-            let mut w = keep;
-            for r in keep..list.len() {
-                let (c2, v2) = list[r];
-                if cand[c2 as usize].cert_ver == v2 {
-                    list[w] = (c2, v2);
-                    w += 1;
-                }
-            }
-            list.truncate(w);
+        if self.forward {
+            let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]);
+            prune(&mut self.watch[t as usize], keep as usize, &self.cand);
         }
-        list.push((c, ver));
+        self.watch[t as usize].push((c, ver));
         self.base_log(Op::Watch(t));
+    }
+
+    /// Adds `(c, ver)` to the watch list of dead-component root `v` (logged), pruned as
+    /// [`State::watch_push`] prunes a triangle's.
+    fn root_watch_push(&mut self, v: u32, c: u32, ver: u32) {
+        if self.forward {
+            let keep = self
+                .initial
+                .as_ref()
+                .map_or(0, |i| i.root_watch_len[v as usize]);
+            prune(&mut self.root_watch[v as usize], keep as usize, &self.cand);
+        }
+        self.root_watch[v as usize].push((c, ver));
+        self.base_log(Op::RootWatch(v));
     }
 
     /// Moves triangle `t` from `P_old` to `P_new` (logged).
@@ -467,4 +483,24 @@ impl State<'_> {
         }
         self.count[t as usize] as u32
     }
+}
+
+/// Forward mode: when watch list `list` has doubled (from 4 entries on), drops the entries
+/// past `keep` (the initial state's, which a reset brings back) whose verdict was since
+/// recomputed, so that a list holds about twice its live entries at most.
+#[inline]
+fn prune(list: &mut WatchList, keep: usize, cand: &[CandRecord]) {
+    let n = list.len();
+    if n < 4 || !n.is_power_of_two() {
+        return;
+    }
+    let mut w = keep;
+    for r in keep..n {
+        let (c2, v2) = list[r];
+        if cand[c2 as usize].cert_ver == v2 {
+            list[w] = (c2, v2);
+            w += 1;
+        }
+    }
+    list.truncate(w);
 }
