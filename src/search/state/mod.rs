@@ -62,6 +62,7 @@ mod check;
 mod oracle;
 mod pk;
 mod tree;
+mod tree_cache;
 mod undo;
 mod verdicts;
 

@@ -24,6 +24,7 @@
 
 use super::TreeEvent;
 use super::check::LOCAL_PROOF;
+use super::tree_cache::CandMap;
 use super::{DEAD, KIND_LOCAL, Op, State, Verdict, is_split};
 use crate::mesh::NONE;
 
@@ -52,8 +53,9 @@ struct Cached {
 /// The tree's side of the state: its path, its verdict cache and scratch.
 #[derive(Debug, Clone)]
 pub(super) struct Overlay {
-    /// Verdicts computed inside the tree, with the node they were computed at.
-    cached: Vec<Cached>,
+    /// Verdicts computed inside the tree, with the node they were computed at (only what
+    /// the current tree stored: emptied at each `tree_begin`).
+    cached: CandMap<Cached>,
     /// Ancestors' verdicts overwritten below them, restored when the node is popped:
     /// `(depth of the overwriting node, candidate, the entry)`.
     shadowed: Vec<(u32, u32, Cached)>,
@@ -104,7 +106,7 @@ impl Overlay {
             slots_serial: Vec::new(),
             touched_at: Vec::new(),
             touched_log: Vec::new(),
-            cached: Vec::new(),
+            cached: CandMap::new(),
             shadowed: Vec::new(),
             cert: Vec::new(),
             cert_len: Vec::new(),
@@ -138,15 +140,16 @@ impl State<'_> {
         assert!(self.tree.is_empty(), "tree_begin with actions pushed");
         self.resolve_all();
         let tr = &mut self.tree;
-        if tr.cached.is_empty() {
-            let (m, nv, nt) = tr.sizes;
-            tr.cached = vec![Cached::default(); m];
+        if tr.touched_at.is_empty() {
+            let (_, nv, nt) = tr.sizes;
             tr.touched_at = vec![0; nv];
             tr.affected_mark = vec![0; nt];
         }
+        // The previous tree's verdicts are never read again (their serial numbers are
+        // older than every node of this tree).
+        tr.cached.clear();
         if tr.next_serial >= u32::MAX - (1 << 20) {
-            // Serial numbers are about to wrap: forget every cached verdict.
-            tr.cached.iter_mut().for_each(|e| e.serial = 0);
+            // Serial numbers are about to wrap: forget every serial kept.
             tr.slots_serial.iter_mut().for_each(|s| *s = 0);
             tr.touched_at.iter_mut().for_each(|s| *s = 0);
             tr.next_serial = 0;
@@ -308,7 +311,7 @@ impl State<'_> {
         let ci = c as usize;
         let tr = &self.tree;
         let d = tr.path.len();
-        let e = tr.cached[ci];
+        let e = tr.cached.get(c);
         let od = e.depth as usize;
         let ancestor = od <= d && tr.serial[od] == e.serial;
         if ancestor {
@@ -333,11 +336,12 @@ impl State<'_> {
             let old = (d as u32, c, e);
             tr.shadowed.push(old);
         }
-        tr.cached[ci] = Cached {
+        let e = Cached {
             verdict: v,
             depth: d as u32,
             serial: tr.serial[d],
         };
+        tr.cached.set(c, e);
         (v.allowed, v.kind)
     }
 
@@ -415,8 +419,7 @@ impl State<'_> {
             if at < d {
                 break;
             }
-            let ci = c as usize;
-            tr.cached[ci] = e;
+            tr.cached.set(c, e);
             tr.shadowed.pop();
         }
         let c = tr.path.pop().expect("a pushed action");
