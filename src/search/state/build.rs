@@ -113,9 +113,7 @@ impl<'a> State<'a> {
             .map(|c| {
                 let (quad, nb) = (table.quads[c], cand_nb[c]);
                 let mut l = CandRecord {
-                    quad,
                     nb,
-                    pair: table.pairs[c],
                     verdict: Verdict::default(),
                     cert_ver: 0,
                     flags: 0,
@@ -146,10 +144,7 @@ impl<'a> State<'a> {
                             .unwrap_or(NONE);
                     }
                 }
-                TriRecord {
-                    ring: r,
-                    cands: table.by_triangle[t],
-                }
+                TriRecord { ring: r }
             })
             .collect();
         let mut st = State {

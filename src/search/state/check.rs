@@ -58,8 +58,9 @@ impl State<'_> {
     #[inline(always)]
     pub(super) fn clean_mask(&self, c: u32) -> u8 {
         let l = &self.cand[c as usize];
+        let q = &self.table.quads[c as usize];
         let (dead, alive) = (&self.dead_count[..], &self.alive[..]);
-        let clean = |i: usize| ((dead[l.quad[i] as usize] == 0) as u8) << i;
+        let clean = |i: usize| ((dead[q[i] as usize] == 0) as u8) << i;
         // `get` answers false for NONE (out of range): no separate test.
         let live = |i: usize| ((alive.get(l.nb[i] as usize) == Some(&true)) as u8) << i;
         let mask = (clean(0) | clean(1) | clean(2) | clean(3)) & l.flags;
@@ -70,9 +71,9 @@ impl State<'_> {
     /// [`State::check`] when the local proof does not settle it (or the quad has a
     /// neighbour across two of its sides); `mask`: the clean quad vertices.
     pub(super) fn check_slow(&mut self, c: u32, mask: u8) -> Verdict {
-        let [t0, t1] = self.cand[c as usize].pair;
+        let [t0, t1] = self.table.pairs[c as usize];
         let n = self.cand[c as usize].nb;
-        let q = self.cand[c as usize].quad;
+        let q = self.table.quads[c as usize];
         // Group label of each neighbour slot, kept flat: joining relabels the 4 slots.
         let mut root = [0u8, 1, 2, 3];
         #[inline(always)]
@@ -386,7 +387,7 @@ impl State<'_> {
         changed: &[u32],
     ) -> Option<bool> {
         if v.mask != 0 {
-            let q = self.cand[c as usize].quad;
+            let q = self.table.quads[c as usize];
             for i in 0..4 {
                 if v.mask & (1 << i) != 0 && self.dead_count[q[i] as usize] != 0 {
                     return None;
@@ -421,7 +422,7 @@ impl State<'_> {
         if v.kind == KIND_MET {
             return Some(true);
         }
-        let t0 = self.cand[c as usize].pair[0];
+        let t0 = self.table.pairs[c as usize][0];
         if v.kind == KIND_SPLIT_LONG {
             let p = self.polder[t0 as usize];
             return (!changed.contains(&p)).then_some(v.allowed);

@@ -182,7 +182,7 @@ impl State<'_> {
     pub fn tree_allowed_mask(&mut self, t: u32) -> u8 {
         if self.tree.is_empty() {
             let mut bits = 0;
-            for (i, c) in self.tri[t as usize].cands.into_iter().enumerate() {
+            for (i, c) in self.table.by_triangle[t as usize].into_iter().enumerate() {
                 if c != NONE && self.is_allowed(c) {
                     bits |= 1 << i;
                 }
@@ -270,7 +270,7 @@ impl State<'_> {
         if !self.alive[t as usize] {
             return slot;
         }
-        for (i, c) in self.tri[t as usize].cands.into_iter().enumerate() {
+        for (i, c) in self.table.by_triangle[t as usize].into_iter().enumerate() {
             if c == NONE || !self.alive[self.other(c, t) as usize] {
                 continue;
             }
@@ -352,7 +352,7 @@ impl State<'_> {
             "tree_push({c}): a triangle of the pair is already used"
         );
         let ci = c as usize;
-        let [t0, t1] = self.cand[ci].pair;
+        let [t0, t1] = self.table.pairs[ci];
         // Only a split changes more than the polder's size.
         let split = is_split(self.tree_verdict(c).1);
         self.log.push(Op::TreeApply(c));
@@ -387,7 +387,7 @@ impl State<'_> {
             }
         }
         self.remaining -= 2;
-        let q = self.cand[ci].quad;
+        let q = self.table.quads[ci];
         for i in 1..4 {
             self.union(q[0], q[i], true);
         }
@@ -427,7 +427,7 @@ impl State<'_> {
         tr.changed.truncate(n);
         let n = tr.cert_len.pop().expect("logged");
         tr.cert.truncate(n);
-        for v in self.cand[c as usize].quad.into_iter().rev() {
+        for v in self.table.quads[c as usize].into_iter().rev() {
             tr.touched_at[v as usize] = tr.touched_log.pop().expect("logged");
         }
         tr.serial.pop();
@@ -438,7 +438,7 @@ impl State<'_> {
             let Op::TreeApply(c) = op else {
                 unreachable!("a base change inside a look-ahead tree");
             };
-            for x in self.cand[c as usize].pair {
+            for x in self.table.pairs[c as usize] {
                 self.alive[x as usize] = true;
                 self.stamp[x as usize] = 0;
                 for v in self.verts(x) {
@@ -531,15 +531,19 @@ impl State<'_> {
     pub fn tree_affected(&self, out: &mut Vec<u32>) {
         let tr = &self.tree;
         for &c in &tr.path {
-            for x in self.cand[c as usize].pair {
-                out.extend(self.tri[x as usize].cands.iter().filter(|&&c2| c2 != NONE));
+            for x in self.table.pairs[c as usize] {
+                out.extend(
+                    self.table.by_triangle[x as usize]
+                        .iter()
+                        .filter(|&&c2| c2 != NONE),
+                );
                 for &(c2, ver) in &self.watch[x as usize] {
                     if self.cand[c2 as usize].cert_ver == ver {
                         out.push(c2);
                     }
                 }
             }
-            for v in self.cand[c as usize].quad {
+            for v in self.table.quads[c as usize] {
                 let v = v as usize;
                 out.extend(&self.vc_list[self.vc_start[v] as usize..self.vc_start[v + 1] as usize]);
             }
@@ -557,7 +561,7 @@ impl State<'_> {
         // takes a split on the path (otherwise every polder lost an even number).
         if !tr.changed.is_empty() {
             for &c2 in &self.split {
-                let t0 = self.cand[c2 as usize].pair[0];
+                let t0 = self.table.pairs[c2 as usize][0];
                 if self.is_live(c2) && tr.changed.contains(&self.polder[t0 as usize]) {
                     out.push(c2);
                 }
@@ -580,7 +584,7 @@ impl State<'_> {
         }
         let epoch = tr.affected_epoch;
         for &c in &cands {
-            for t in self.cand[c as usize].pair {
+            for t in self.table.pairs[c as usize] {
                 if tr.affected_mark[t as usize] != epoch {
                     tr.affected_mark[t as usize] = epoch;
                     tr.affected.push(t);

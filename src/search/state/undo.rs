@@ -25,7 +25,7 @@ impl State<'_> {
             self.compact_base_cert();
         }
         let ci = c as usize;
-        let [t0, t1] = self.cand[ci].pair;
+        let [t0, t1] = self.table.pairs[ci];
         assert!(
             self.is_live(c),
             "apply({c}): a triangle of the pair is already used"
@@ -93,7 +93,7 @@ impl State<'_> {
         self.quality.push(total);
         for x in [t0, t1] {
             self.set_count(x, 0);
-            for c2 in self.tri[x as usize].cands {
+            for c2 in self.table.by_triangle[x as usize] {
                 if c2 != NONE && self.cand[c2 as usize].verdict.allowed {
                     self.set_verdict_dead(c2);
                     let u = self.other(c2, x);
@@ -116,7 +116,7 @@ impl State<'_> {
             }
         }
         // The quad joins the dead components at its four vertices.
-        let qv = self.cand[ci].quad;
+        let qv = self.table.quads[ci];
         for i in 1..4 {
             if let Some(child) = self.union(qv[0], qv[i], false) {
                 if distinct {
@@ -176,7 +176,7 @@ impl State<'_> {
             for i in 0..self.split.len() {
                 let c2 = self.split[i];
                 if self.is_live(c2) {
-                    let pc = self.polder[self.cand[c2 as usize].pair[0] as usize];
+                    let pc = self.polder[self.table.pairs[c2 as usize][0] as usize];
                     if self.changed.contains(&pc) {
                         self.mark(c2);
                     }
@@ -196,7 +196,7 @@ impl State<'_> {
             }
             match op {
                 Op::Apply(c) => {
-                    let [t0, t1] = self.cand[c as usize].pair;
+                    let [t0, t1] = self.table.pairs[c as usize];
                     for x in [t0, t1] {
                         self.alive[x as usize] = true;
                         self.stamp[x as usize] = 0;

@@ -46,7 +46,7 @@ impl State<'_> {
         (r.cert, r.cert_len) = self.append_cert(r.kind, false);
         self.cand[ci].verdict = r;
         if r.allowed != old.allowed {
-            let [t0, t1] = self.cand[ci].pair;
+            let [t0, t1] = self.table.pairs[ci];
             for t in [t0, t1] {
                 let k = self.count[t as usize];
                 self.set_count(t, if r.allowed { k + 1 } else { k - 1 });
@@ -110,7 +110,7 @@ impl State<'_> {
         if v.kind != KIND_SPLIT || v.mask & LINKED != 0 {
             return false;
         }
-        let (qc, qy) = (self.cand[ci].quad, self.cand[y as usize].quad);
+        let (qc, qy) = (self.table.quads[ci], self.table.quads[y as usize]);
         if distinct {
             if qc.iter().any(|a| qy.contains(a)) || !self.distinct_without(c) {
                 return false;
@@ -125,11 +125,11 @@ impl State<'_> {
                     ymask &= !(1 << i);
                 }
             }
-            if !self.joined_without(y, ymask, self.cand[ci].pair) {
+            if !self.joined_without(y, ymask, self.table.pairs[ci]) {
                 return false;
             }
         }
-        let [a, b] = self.cand[y as usize].pair;
+        let [a, b] = self.table.pairs[y as usize];
         let (off, fin, len) = (v.cert as usize, v.fin_known as usize, v.cert_len as usize);
         let cert = &self.base_cert[off..off + len];
         let keep = |t: &u32| *t != a && *t != b;
@@ -191,7 +191,7 @@ impl State<'_> {
     /// (roots before this `apply`'s unions, which attached the roots in `attached`).
     fn distinct_without(&self, c: u32) -> bool {
         let mut hit = NONE;
-        for v in self.cand[c as usize].quad {
+        for v in self.table.quads[c as usize] {
             // The root before this apply: no path compression, so walk up to the first
             // vertex that was a root then.
             let mut r = v;
@@ -249,8 +249,8 @@ impl State<'_> {
     /// close within 64 steps.
     fn fans(&mut self, y: u32, mask: u8) -> bool {
         self.fan.clear();
-        let [a, b] = self.cand[y as usize].pair;
-        let q = self.cand[y as usize].quad;
+        let [a, b] = self.table.pairs[y as usize];
+        let q = self.table.quads[y as usize];
         for (i, &v) in q.iter().enumerate() {
             if mask & (1 << i) == 0 {
                 continue;
@@ -303,7 +303,7 @@ impl State<'_> {
             if (v.cert as usize) < init || v.cert_len == 0 {
                 continue;
             }
-            let [a, b] = self.cand[c].pair;
+            let [a, b] = self.table.pairs[c];
             if !self.alive[a as usize] || !self.alive[b as usize] {
                 // Never read again before a reset restores the initial verdicts.
                 let v = &mut self.cand[c].verdict;
@@ -475,7 +475,7 @@ impl State<'_> {
     #[inline]
     pub fn allowed_count_lazy(&mut self, t: u32) -> u32 {
         if self.alive[t as usize] {
-            for c in self.tri[t as usize].cands {
+            for c in self.table.by_triangle[t as usize] {
                 if c != NONE {
                     self.resolve(c);
                 }
