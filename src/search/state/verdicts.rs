@@ -372,7 +372,7 @@ impl State<'_> {
             let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]);
             prune(&mut self.watch[t as usize], keep as usize, &self.cand);
         }
-        self.watch[t as usize].push((c, ver));
+        push_entry(&mut self.watch[t as usize], (c, ver), self.building);
         self.base_log(Op::Watch(t));
     }
 
@@ -386,7 +386,7 @@ impl State<'_> {
                 .map_or(0, |i| i.root_watch_len[v as usize]);
             prune(&mut self.root_watch[v as usize], keep as usize, &self.cand);
         }
-        self.root_watch[v as usize].push((c, ver));
+        push_entry(&mut self.root_watch[v as usize], (c, ver), self.building);
         self.base_log(Op::RootWatch(v));
     }
 
@@ -503,4 +503,17 @@ fn prune(list: &mut WatchList, keep: usize, cand: &[CandRecord]) {
         }
     }
     list.truncate(w);
+}
+
+/// Pushes onto a watch list. While the initial verdicts are built (`building`) a list's
+/// first block has room for one entry (`ThinVec` starts at four; most lists of a corridor
+/// hold one or two for the whole run), then it doubles; during a run a list grows to four
+/// at once (each reallocation costs more than the room).
+#[inline]
+fn push_entry(list: &mut WatchList, e: (u32, u32), building: bool) {
+    let (len, cap) = (list.len(), list.capacity());
+    if len == cap && cap < 4 {
+        list.reserve_exact(if building && cap == 0 { 1 } else { 4 - len });
+    }
+    list.push(e);
 }
