@@ -267,9 +267,14 @@ impl CandidateTable {
             return self;
         }
         let mut new_index = vec![NONE; self.len()];
+        // Sized once: grown by doubling, the arrays kept up to 2x their length for the
+        // whole run (a grid's table is most of a 10^6-triangle run's memory after the mesh).
+        let n = keep.iter().filter(|&&k| k).count();
         let mut out = CandidateTable {
+            pairs: Vec::with_capacity(n),
+            quads: Vec::with_capacity(n),
+            eta: Vec::with_capacity(n),
             by_triangle: self.by_triangle,
-            ..CandidateTable::default()
         };
         for c in (0..self.pairs.len()).filter(|&c| keep[c]) {
             new_index[c] = out.pairs.len() as u32;

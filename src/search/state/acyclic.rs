@@ -84,7 +84,7 @@ impl State<'_> {
     /// in scratch as [`State::check`] leaves it; `None` to search instead (another
     /// component, or a clean quad vertex, which takes a cycle around it).
     pub(super) fn acyclic_verdict(&mut self, a: &Acyclic, c: u32) -> Option<Verdict> {
-        let [t0, t1] = self.cand[c as usize].pair;
+        let [t0, t1] = self.table.pairs[c as usize];
         let total = a.component[t0 as usize];
         if total == 0 || self.clean_mask(c) != 0 {
             return None;

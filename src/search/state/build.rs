@@ -4,7 +4,7 @@
 
 use super::pk::OrderedSets;
 use super::tree::Overlay;
-use super::{CandRecord, ROOT_TAG, State, TriRecord, Verdict};
+use super::{CandRecord, ROOT_TAG, State, TriRecord, Verdict, WatchList};
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 
@@ -113,9 +113,7 @@ impl<'a> State<'a> {
             .map(|c| {
                 let (quad, nb) = (table.quads[c], cand_nb[c]);
                 let mut l = CandRecord {
-                    quad,
                     nb,
-                    pair: table.pairs[c],
                     verdict: Verdict::default(),
                     cert_ver: 0,
                     flags: 0,
@@ -146,10 +144,7 @@ impl<'a> State<'a> {
                             .unwrap_or(NONE);
                     }
                 }
-                TriRecord {
-                    ring: r,
-                    cands: table.by_triangle[t],
-                }
+                TriRecord { ring: r }
             })
             .collect();
         let mut st = State {
@@ -172,10 +167,10 @@ impl<'a> State<'a> {
             dead_count: vec![0; nv],
             polder,
             polder_size,
-            watch: vec![Vec::new(); nt],
+            watch: (0..nt).map(|_| WatchList::new()).collect(),
             dsu_parent: (0..nv as u32).collect(),
             dsu_size: vec![1; nv],
-            root_watch: vec![Vec::new(); nv],
+            root_watch: (0..nv).map(|_| WatchList::new()).collect(),
             arc_roots: [NONE; 4],
             narcs: 0,
             split: Vec::new(),
@@ -215,13 +210,13 @@ impl<'a> State<'a> {
         for (t, tri) in mesh.triangles.iter().enumerate() {
             for i in 0..3 {
                 if st.dual[t][i] == NONE {
-                    st.union(tri[i], tri[(i + 1) % 3]);
+                    st.union(tri[i], tri[(i + 1) % 3], false);
                 }
             }
         }
         for q in &mesh.quads {
             for i in 1..4 {
-                st.union(q[0], q[i]);
+                st.union(q[0], q[i], false);
             }
         }
         // Components without a cycle (corridors) all at once; a search per candidate
@@ -234,10 +229,10 @@ impl<'a> State<'a> {
             }
         }
         drop(acyclic);
-        // The initial verdicts are the base state: nothing to undo before it (their changes
-        // were not logged; the few unions of the boundary were).
+        // The initial verdicts are the base state: nothing to undo before it (their changes,
+        // the boundary's unions included, were not logged).
         st.building = false;
-        st.log = Vec::new();
+        debug_assert!(st.log.is_empty());
         st.base_cert_init = st.base_cert.len();
         st.base_cert.shrink_to_fit();
         st.base_cert_compact_at = st.base_cert_init + m.max(1024);

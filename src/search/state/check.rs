@@ -58,8 +58,9 @@ impl State<'_> {
     #[inline(always)]
     pub(super) fn clean_mask(&self, c: u32) -> u8 {
         let l = &self.cand[c as usize];
+        let q = &self.table.quads[c as usize];
         let (dead, alive) = (&self.dead_count[..], &self.alive[..]);
-        let clean = |i: usize| ((dead[l.quad[i] as usize] == 0) as u8) << i;
+        let clean = |i: usize| ((dead[q[i] as usize] == 0) as u8) << i;
         // `get` answers false for NONE (out of range): no separate test.
         let live = |i: usize| ((alive.get(l.nb[i] as usize) == Some(&true)) as u8) << i;
         let mask = (clean(0) | clean(1) | clean(2) | clean(3)) & l.flags;
@@ -70,9 +71,9 @@ impl State<'_> {
     /// [`State::check`] when the local proof does not settle it (or the quad has a
     /// neighbour across two of its sides); `mask`: the clean quad vertices.
     pub(super) fn check_slow(&mut self, c: u32, mask: u8) -> Verdict {
-        let [t0, t1] = self.cand[c as usize].pair;
+        let [t0, t1] = self.table.pairs[c as usize];
         let n = self.cand[c as usize].nb;
-        let q = self.cand[c as usize].quad;
+        let q = self.table.quads[c as usize];
         // Group label of each neighbour slot, kept flat: joining relabels the 4 slots.
         let mut root = [0u8, 1, 2, 3];
         #[inline(always)]
@@ -386,7 +387,7 @@ impl State<'_> {
         changed: &[u32],
     ) -> Option<bool> {
         if v.mask != 0 {
-            let q = self.cand[c as usize].quad;
+            let q = self.table.quads[c as usize];
             for i in 0..4 {
                 if v.mask & (1 << i) != 0 && self.dead_count[q[i] as usize] != 0 {
                     return None;
@@ -421,7 +422,7 @@ impl State<'_> {
         if v.kind == KIND_MET {
             return Some(true);
         }
-        let t0 = self.cand[c as usize].pair[0];
+        let t0 = self.table.pairs[c as usize][0];
         if v.kind == KIND_SPLIT_LONG {
             let p = self.polder[t0 as usize];
             return (!changed.contains(&p)).then_some(v.allowed);
@@ -440,9 +441,10 @@ impl State<'_> {
         v
     }
 
-    /// Joins the dead components of `a` and `b` (logged); returns the root that was attached
+    /// Joins the dead components of `a` and `b` (logged inside a look-ahead tree, `tree`,
+    /// else as a base change: [`State::shared_log`]); returns the root that was attached
     /// under the other, if they were distinct.
-    pub(super) fn union(&mut self, a: u32, b: u32) -> Option<u32> {
+    pub(super) fn union(&mut self, a: u32, b: u32, tree: bool) -> Option<u32> {
         let (mut ra, mut rb) = (self.find(a), self.find(b));
         if ra == rb {
             return None;
@@ -452,10 +454,13 @@ impl State<'_> {
         }
         self.dsu_parent[rb as usize] = ra;
         self.dsu_size[ra as usize] += self.dsu_size[rb as usize];
-        self.log.push(Op::Union {
-            child: rb,
-            root: ra,
-        });
+        self.shared_log(
+            Op::Union {
+                child: rb,
+                root: ra,
+            },
+            tree,
+        );
         Some(rb)
     }
 
@@ -466,10 +471,10 @@ impl State<'_> {
     }
 
     /// After a [`State::check`] that found a split of the polder of `t0`: gives each
-    /// finished part a new polder id (logged) and the rest (the running part, or the largest
+    /// finished part a new polder id (logged as [`State::union`] is) and the rest (the running part, or the largest
     /// when all finished) the old id with its new size. The ids whose size changed parity
     /// are left in `changed`.
-    pub(super) fn relabel_split(&mut self, t0: u32) {
+    pub(super) fn relabel_split(&mut self, t0: u32, tree: bool) {
         let p = self.polder[t0 as usize];
         let psize = self.polder_size[p as usize];
         let ns = self.nsearch;
@@ -496,7 +501,7 @@ impl State<'_> {
             }
             let id = self.polder_size.len() as u32;
             self.polder_size.push(gsize[g]);
-            self.log.push(Op::PolderNew);
+            self.shared_log(Op::PolderNew, tree);
             known += gsize[g];
             if gsize[g] % 2 != psize % 2 {
                 self.changed.push(id);
@@ -507,7 +512,7 @@ impl State<'_> {
                 }
                 for i in 0..self.queue[s].len() {
                     let t = self.queue[s][i];
-                    self.log.push(Op::Polder { t, old: p });
+                    self.shared_log(Op::Polder { t, old: p }, tree);
                     self.polder[t as usize] = id;
                 }
             }
@@ -516,7 +521,7 @@ impl State<'_> {
         if rest % 2 != psize % 2 {
             self.changed.push(p);
         }
-        self.log.push(Op::PolderSize { p, old: psize });
+        self.shared_log(Op::PolderSize { p, old: psize }, tree);
         self.polder_size[p as usize] = rest;
     }
 }

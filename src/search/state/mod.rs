@@ -39,11 +39,12 @@
 //!   vertices still clean, its certificate intact: checked on reading, nothing is marked),
 //!   else recomputed. `P_min` inside the tree (rare) is the base sets corrected by the
 //!   triangles the path can have changed.
-//! * **Layout.** What is read together is stored together: one 64-byte record per candidate
-//!   (quad, neighbours, pair, verdict, its version and stale mark) and one per triangle
-//!   (its ring of vertices and its candidates), so that touching an element costs one
-//!   cache line; the lockstep search, which streams through many triangles for their
-//!   neighbours only, reads the mesh's dense dual graph instead.
+//! * **Layout.** What is read together is stored together: one 40-byte record per candidate
+//!   (the quad's neighbours, verdict, its version and stale mark) and one per triangle (its
+//!   ring of vertices); the quad, the pair and each triangle's candidates are read from the
+//!   table, not repeated (memory: a 64-byte candidate record with them cost 80 bytes per
+//!   triangle of a grid); the lockstep search, which streams through many triangles for
+//!   their neighbours only, reads a dense dual graph.
 //!
 //! # Files
 //! This module holds the records, the [`State`] struct and its read-only accessors;
@@ -62,6 +63,7 @@ mod check;
 mod oracle;
 mod pk;
 mod tree;
+mod tree_cache;
 mod undo;
 mod verdicts;
 
@@ -70,8 +72,14 @@ use crate::quality::CandidateTable;
 pub use audit::{TreeAudit, TreeEvent, TreeView};
 pub use oracle::naive_allowed;
 use pk::OrderedSets;
+use thin_vec::ThinVec;
 pub use tree::Near;
 use tree::Overlay;
+
+/// A watch list: the verdicts `(candidate, version)` whose certificate holds an element.
+/// One pointer (8 bytes; an empty list allocates nothing), where a `Vec` took 24 bytes per
+/// triangle and per vertex, most of them empty or short.
+type WatchList = ThinVec<(u32, u32)>;
 
 /// How a verdict was reached (what it depends on).
 const KIND_LOCAL: u8 = 0;
@@ -106,17 +114,13 @@ const ROOT_TAG: u32 = 1 << 31;
 fn is_split(kind: u8) -> bool {
     kind == KIND_SPLIT || kind == KIND_SPLIT_LONG
 }
-/// Per candidate, on one cache line (64 bytes, aligned): what the local proof reads, its
-/// pair, its verdict, the verdict's version and stale mark, which are read together.
+/// Per candidate: what the local proof reads beside the quad (the table's `quads`), its
+/// verdict, the verdict's version and stale mark, which are read together. 40 bytes: the
+/// quad and the pair are read from the table (they were repeated here, on a 64-byte line).
 #[derive(Debug, Clone, Copy)]
-#[repr(align(64))]
 struct CandRecord {
-    /// The quad's vertices and the neighbours across its sides (NONE where none).
-    quad: [u32; 4],
+    /// The neighbours across the quad's sides (NONE where none).
     nb: [u32; 4],
-    /// The candidate's two triangles (as in the table; kept here, on the same cache line
-    /// as the rest, because nearly every access to a candidate reads them).
-    pair: [u32; 2],
     /// Its current verdict (base state).
     verdict: Verdict,
     /// Version of the verdict, which the watch lists refer to (read for every watch entry,
@@ -129,18 +133,16 @@ struct CandRecord {
     /// The verdict was marked possibly stale by an action and not yet rechecked.
     dirty: bool,
 }
-const _: () = assert!(std::mem::size_of::<CandRecord>() == 64);
+const _: () = assert!(std::mem::size_of::<CandRecord>() == 40);
 
 /// Per triangle, in one record: what `apply` and the trees read about it. The triangle
 /// across each side is in the state's dense `dual` (kept once: the searches stream through
-/// it).
+/// it), the candidate across each side in the table's `by_triangle` (not repeated here).
 #[derive(Debug, Clone, Copy)]
 struct TriRecord {
     /// Its vertices, then the vertex across each of its sides (NONE without a neighbour):
     /// every vertex of every quad it can be part of.
     ring: [u32; 6],
-    /// The candidate across each side (the table's `by_triangle`), or NONE.
-    cands: [u32; 3],
 }
 
 /// Owner mark for the two triangles being removed during a search.
@@ -232,9 +234,9 @@ pub struct State<'a> {
     // ---- static ----
     /// Vertex fan is one closed cycle of triangles in the dual graph.
     closed: Vec<bool>,
-    /// Per candidate: its quad, neighbours, pair, verdict, version, stale mark (one cache line).
+    /// Per candidate: its quad's neighbours, verdict, version, stale mark.
     cand: Vec<CandRecord>,
-    /// Per triangle: its ring of vertices and its candidates.
+    /// Per triangle: its ring of vertices.
     tri: Vec<TriRecord>,
     /// The candidates' dual graph as a dense array (the triangle across each side through a
     /// candidate, or NONE), which the lockstep searches stream through.
@@ -258,13 +260,13 @@ pub struct State<'a> {
     dead_count: Vec<u32>,
     polder: Vec<u32>,
     polder_size: Vec<u32>,
-    watch: Vec<Vec<(u32, u32)>>,
+    watch: Vec<WatchList>,
     /// Union-find (by size, no path compression, so it can be undone) over vertices: the
     /// connected pieces of the removed region (used triangles, boundaries, input quads).
     dsu_parent: Vec<u32>,
     dsu_size: Vec<u32>,
     /// Verdicts that rely on a dead-component root staying a root.
-    root_watch: Vec<Vec<(u32, u32)>>,
+    root_watch: Vec<WatchList>,
     arc_roots: [u32; 4],
     narcs: usize,
     split: Vec<u32>,
@@ -360,7 +362,7 @@ impl<'a> State<'a> {
     /// Both triangles of `c` remain (whatever the criterion says).
     #[inline]
     pub fn is_live(&self, c: u32) -> bool {
-        let [a, b] = self.cand[c as usize].pair;
+        let [a, b] = self.table.pairs[c as usize];
         self.alive[a as usize] && self.alive[b as usize]
     }
 
@@ -371,17 +373,16 @@ impl<'a> State<'a> {
         [r[0], r[1], r[2]]
     }
 
-    /// The candidate across each side of triangle `t` (the table's `by_triangle[t]`), read
-    /// from the state's per-triangle record.
+    /// The candidate across each side of triangle `t` (the table's `by_triangle[t]`).
     #[inline]
     pub fn candidates_of(&self, t: u32) -> [u32; 3] {
-        self.tri[t as usize].cands
+        self.table.by_triangle[t as usize]
     }
 
     /// The triangle of `c` other than `t`.
     #[inline]
     fn other(&self, c: u32, t: u32) -> u32 {
-        let [a, b] = self.cand[c as usize].pair;
+        let [a, b] = self.table.pairs[c as usize];
         if a == t { b } else { a }
     }
 

@@ -24,6 +24,7 @@
 
 use super::TreeEvent;
 use super::check::LOCAL_PROOF;
+use super::tree_cache::CandMap;
 use super::{DEAD, KIND_LOCAL, Op, State, Verdict, is_split};
 use crate::mesh::NONE;
 
@@ -52,8 +53,9 @@ struct Cached {
 /// The tree's side of the state: its path, its verdict cache and scratch.
 #[derive(Debug, Clone)]
 pub(super) struct Overlay {
-    /// Verdicts computed inside the tree, with the node they were computed at.
-    cached: Vec<Cached>,
+    /// Verdicts computed inside the tree, with the node they were computed at (only what
+    /// the current tree stored: emptied at each `tree_begin`).
+    cached: CandMap<Cached>,
     /// Ancestors' verdicts overwritten below them, restored when the node is popped:
     /// `(depth of the overwriting node, candidate, the entry)`.
     shadowed: Vec<(u32, u32, Cached)>,
@@ -104,7 +106,7 @@ impl Overlay {
             slots_serial: Vec::new(),
             touched_at: Vec::new(),
             touched_log: Vec::new(),
-            cached: Vec::new(),
+            cached: CandMap::new(),
             shadowed: Vec::new(),
             cert: Vec::new(),
             cert_len: Vec::new(),
@@ -138,15 +140,16 @@ impl State<'_> {
         assert!(self.tree.is_empty(), "tree_begin with actions pushed");
         self.resolve_all();
         let tr = &mut self.tree;
-        if tr.cached.is_empty() {
-            let (m, nv, nt) = tr.sizes;
-            tr.cached = vec![Cached::default(); m];
+        if tr.touched_at.is_empty() {
+            let (_, nv, nt) = tr.sizes;
             tr.touched_at = vec![0; nv];
             tr.affected_mark = vec![0; nt];
         }
+        // The previous tree's verdicts are never read again (their serial numbers are
+        // older than every node of this tree).
+        tr.cached.clear();
         if tr.next_serial >= u32::MAX - (1 << 20) {
-            // Serial numbers are about to wrap: forget every cached verdict.
-            tr.cached.iter_mut().for_each(|e| e.serial = 0);
+            // Serial numbers are about to wrap: forget every serial kept.
             tr.slots_serial.iter_mut().for_each(|s| *s = 0);
             tr.touched_at.iter_mut().for_each(|s| *s = 0);
             tr.next_serial = 0;
@@ -179,7 +182,7 @@ impl State<'_> {
     pub fn tree_allowed_mask(&mut self, t: u32) -> u8 {
         if self.tree.is_empty() {
             let mut bits = 0;
-            for (i, c) in self.tri[t as usize].cands.into_iter().enumerate() {
+            for (i, c) in self.table.by_triangle[t as usize].into_iter().enumerate() {
                 if c != NONE && self.is_allowed(c) {
                     bits |= 1 << i;
                 }
@@ -267,7 +270,7 @@ impl State<'_> {
         if !self.alive[t as usize] {
             return slot;
         }
-        for (i, c) in self.tri[t as usize].cands.into_iter().enumerate() {
+        for (i, c) in self.table.by_triangle[t as usize].into_iter().enumerate() {
             if c == NONE || !self.alive[self.other(c, t) as usize] {
                 continue;
             }
@@ -308,7 +311,7 @@ impl State<'_> {
         let ci = c as usize;
         let tr = &self.tree;
         let d = tr.path.len();
-        let e = tr.cached[ci];
+        let e = tr.cached.get(c);
         let od = e.depth as usize;
         let ancestor = od <= d && tr.serial[od] == e.serial;
         if ancestor {
@@ -333,11 +336,12 @@ impl State<'_> {
             let old = (d as u32, c, e);
             tr.shadowed.push(old);
         }
-        tr.cached[ci] = Cached {
+        let e = Cached {
             verdict: v,
             depth: d as u32,
             serial: tr.serial[d],
         };
+        tr.cached.set(c, e);
         (v.allowed, v.kind)
     }
 
@@ -348,7 +352,7 @@ impl State<'_> {
             "tree_push({c}): a triangle of the pair is already used"
         );
         let ci = c as usize;
-        let [t0, t1] = self.cand[ci].pair;
+        let [t0, t1] = self.table.pairs[ci];
         // Only a split changes more than the polder's size.
         let split = is_split(self.tree_verdict(c).1);
         self.log.push(Op::TreeApply(c));
@@ -363,7 +367,7 @@ impl State<'_> {
             let inherited = self.tree.changed.contains(&p);
             let first_new = self.polder_size.len() as u32;
             self.changed.clear();
-            self.relabel_split(t0);
+            self.relabel_split(t0, true);
             self.tree.changed.extend_from_slice(&self.changed);
             if inherited {
                 let tr = &mut self.tree;
@@ -383,9 +387,9 @@ impl State<'_> {
             }
         }
         self.remaining -= 2;
-        let q = self.cand[ci].quad;
+        let q = self.table.quads[ci];
         for i in 1..4 {
-            self.union(q[0], q[i]);
+            self.union(q[0], q[i], true);
         }
         let tr = &mut self.tree;
         tr.next_serial += 1;
@@ -415,8 +419,7 @@ impl State<'_> {
             if at < d {
                 break;
             }
-            let ci = c as usize;
-            tr.cached[ci] = e;
+            tr.cached.set(c, e);
             tr.shadowed.pop();
         }
         let c = tr.path.pop().expect("a pushed action");
@@ -424,7 +427,7 @@ impl State<'_> {
         tr.changed.truncate(n);
         let n = tr.cert_len.pop().expect("logged");
         tr.cert.truncate(n);
-        for v in self.cand[c as usize].quad.into_iter().rev() {
+        for v in self.table.quads[c as usize].into_iter().rev() {
             tr.touched_at[v as usize] = tr.touched_log.pop().expect("logged");
         }
         tr.serial.pop();
@@ -435,7 +438,7 @@ impl State<'_> {
             let Op::TreeApply(c) = op else {
                 unreachable!("a base change inside a look-ahead tree");
             };
-            for x in self.cand[c as usize].pair {
+            for x in self.table.pairs[c as usize] {
                 self.alive[x as usize] = true;
                 self.stamp[x as usize] = 0;
                 for v in self.verts(x) {
@@ -528,15 +531,19 @@ impl State<'_> {
     pub fn tree_affected(&self, out: &mut Vec<u32>) {
         let tr = &self.tree;
         for &c in &tr.path {
-            for x in self.cand[c as usize].pair {
-                out.extend(self.tri[x as usize].cands.iter().filter(|&&c2| c2 != NONE));
+            for x in self.table.pairs[c as usize] {
+                out.extend(
+                    self.table.by_triangle[x as usize]
+                        .iter()
+                        .filter(|&&c2| c2 != NONE),
+                );
                 for &(c2, ver) in &self.watch[x as usize] {
                     if self.cand[c2 as usize].cert_ver == ver {
                         out.push(c2);
                     }
                 }
             }
-            for v in self.cand[c as usize].quad {
+            for v in self.table.quads[c as usize] {
                 let v = v as usize;
                 out.extend(&self.vc_list[self.vc_start[v] as usize..self.vc_start[v + 1] as usize]);
             }
@@ -554,7 +561,7 @@ impl State<'_> {
         // takes a split on the path (otherwise every polder lost an even number).
         if !tr.changed.is_empty() {
             for &c2 in &self.split {
-                let t0 = self.cand[c2 as usize].pair[0];
+                let t0 = self.table.pairs[c2 as usize][0];
                 if self.is_live(c2) && tr.changed.contains(&self.polder[t0 as usize]) {
                     out.push(c2);
                 }
@@ -577,7 +584,7 @@ impl State<'_> {
         }
         let epoch = tr.affected_epoch;
         for &c in &cands {
-            for t in self.cand[c as usize].pair {
+            for t in self.table.pairs[c as usize] {
                 if tr.affected_mark[t as usize] != epoch {
                     tr.affected_mark[t as usize] = epoch;
                     tr.affected.push(t);

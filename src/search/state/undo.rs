@@ -2,8 +2,11 @@
 //! every change as an [`Op`], `undo` reverts the last action in O(1) per change, `reset`
 //! returns to the initial state.
 
-use super::{DEAD, Initial, KIND_DISTINCT, KIND_LOCAL, Op, State, is_split};
+use super::{DEAD, Initial, KIND_DISTINCT, KIND_LOCAL, Op, State, WatchList, is_split};
 use crate::mesh::NONE;
+
+/// Capacity of the change log kept across forward-mode actions (ops; 28 bytes each).
+const LOG_KEEP: usize = 1 << 12;
 
 impl State<'_> {
     /// Recombines the two triangles of candidate `c` (both must remain; the criterion is
@@ -22,7 +25,7 @@ impl State<'_> {
             self.compact_base_cert();
         }
         let ci = c as usize;
-        let [t0, t1] = self.cand[ci].pair;
+        let [t0, t1] = self.table.pairs[ci];
         assert!(
             self.is_live(c),
             "apply({c}): a triangle of the pair is already used"
@@ -63,14 +66,16 @@ impl State<'_> {
         }
         self.attached.clear();
         if self.forward {
-            // Nothing will be undone: the log only serves the trees.
+            // Nothing will be undone: the log only serves the trees, whose splits can have
+            // logged a large part; its capacity goes back.
             self.log.clear();
+            self.log.shrink_to(LOG_KEEP);
         } else {
             self.log.push(Op::Apply(c));
         }
         self.changed.clear();
         if split {
-            self.relabel_split(t0);
+            self.relabel_split(t0, false);
         } else {
             let p = self.polder[t0 as usize];
             let psize = self.polder_size[p as usize];
@@ -88,7 +93,7 @@ impl State<'_> {
         self.quality.push(total);
         for x in [t0, t1] {
             self.set_count(x, 0);
-            for c2 in self.tri[x as usize].cands {
+            for c2 in self.table.by_triangle[x as usize] {
                 if c2 != NONE && self.cand[c2 as usize].verdict.allowed {
                     self.set_verdict_dead(c2);
                     let u = self.other(c2, x);
@@ -111,9 +116,9 @@ impl State<'_> {
             }
         }
         // The quad joins the dead components at its four vertices.
-        let qv = self.cand[ci].quad;
+        let qv = self.table.quads[ci];
         for i in 1..4 {
-            if let Some(child) = self.union(qv[0], qv[i]) {
+            if let Some(child) = self.union(qv[0], qv[i], false) {
                 if distinct {
                     self.attached.push(child);
                 }
@@ -126,7 +131,7 @@ impl State<'_> {
                 // A root attached stays attached until a reset; without one (no initial
                 // copy), its list is never read again.
                 if self.forward && self.initial.is_none() {
-                    self.root_watch[child as usize] = Vec::new();
+                    self.root_watch[child as usize] = WatchList::new();
                 }
             }
         }
@@ -171,7 +176,7 @@ impl State<'_> {
             for i in 0..self.split.len() {
                 let c2 = self.split[i];
                 if self.is_live(c2) {
-                    let pc = self.polder[self.cand[c2 as usize].pair[0] as usize];
+                    let pc = self.polder[self.table.pairs[c2 as usize][0] as usize];
                     if self.changed.contains(&pc) {
                         self.mark(c2);
                     }
@@ -191,7 +196,7 @@ impl State<'_> {
             }
             match op {
                 Op::Apply(c) => {
-                    let [t0, t1] = self.cand[c as usize].pair;
+                    let [t0, t1] = self.table.pairs[c as usize];
                     for x in [t0, t1] {
                         self.alive[x as usize] = true;
                         self.stamp[x as usize] = 0;

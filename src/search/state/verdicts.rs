@@ -2,7 +2,10 @@
 //! certificate (watches, split shrinking), the base certificate log, the counts per
 //! triangle and bucket, stale marks and their lazy resolution.
 
-use super::{KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict, is_split};
+use super::{
+    CandRecord, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict, WatchList,
+    is_split,
+};
 use crate::mesh::NONE;
 
 impl State<'_> {
@@ -43,7 +46,7 @@ impl State<'_> {
         (r.cert, r.cert_len) = self.append_cert(r.kind, false);
         self.cand[ci].verdict = r;
         if r.allowed != old.allowed {
-            let [t0, t1] = self.cand[ci].pair;
+            let [t0, t1] = self.table.pairs[ci];
             for t in [t0, t1] {
                 let k = self.count[t as usize];
                 self.set_count(t, if r.allowed { k + 1 } else { k - 1 });
@@ -51,9 +54,7 @@ impl State<'_> {
         }
         if r.kind == KIND_DISTINCT {
             for i in 0..self.narcs {
-                let root = self.arc_roots[i];
-                self.root_watch[root as usize].push((c, ver));
-                self.base_log(Op::RootWatch(root));
+                self.root_watch_push(self.arc_roots[i], c, ver);
             }
         } else if r.kind != KIND_LOCAL {
             for s in 0..self.nsearch {
@@ -64,9 +65,7 @@ impl State<'_> {
             }
             // Linked groups: every arc's root must stay a root.
             for i in 0..self.narcs {
-                let root = self.arc_roots[i];
-                self.root_watch[root as usize].push((c, ver));
-                self.base_log(Op::RootWatch(root));
+                self.root_watch_push(self.arc_roots[i], c, ver);
             }
         }
         let in_split = self.split_pos[ci] != NONE;
@@ -111,7 +110,7 @@ impl State<'_> {
         if v.kind != KIND_SPLIT || v.mask & LINKED != 0 {
             return false;
         }
-        let (qc, qy) = (self.cand[ci].quad, self.cand[y as usize].quad);
+        let (qc, qy) = (self.table.quads[ci], self.table.quads[y as usize]);
         if distinct {
             if qc.iter().any(|a| qy.contains(a)) || !self.distinct_without(c) {
                 return false;
@@ -126,11 +125,11 @@ impl State<'_> {
                     ymask &= !(1 << i);
                 }
             }
-            if !self.joined_without(y, ymask, self.cand[ci].pair) {
+            if !self.joined_without(y, ymask, self.table.pairs[ci]) {
                 return false;
             }
         }
-        let [a, b] = self.cand[y as usize].pair;
+        let [a, b] = self.table.pairs[y as usize];
         let (off, fin, len) = (v.cert as usize, v.fin_known as usize, v.cert_len as usize);
         let cert = &self.base_cert[off..off + len];
         let keep = |t: &u32| *t != a && *t != b;
@@ -192,7 +191,7 @@ impl State<'_> {
     /// (roots before this `apply`'s unions, which attached the roots in `attached`).
     fn distinct_without(&self, c: u32) -> bool {
         let mut hit = NONE;
-        for v in self.cand[c as usize].quad {
+        for v in self.table.quads[c as usize] {
             // The root before this apply: no path compression, so walk up to the first
             // vertex that was a root then.
             let mut r = v;
@@ -250,8 +249,8 @@ impl State<'_> {
     /// close within 64 steps.
     fn fans(&mut self, y: u32, mask: u8) -> bool {
         self.fan.clear();
-        let [a, b] = self.cand[y as usize].pair;
-        let q = self.cand[y as usize].quad;
+        let [a, b] = self.table.pairs[y as usize];
+        let q = self.table.quads[y as usize];
         for (i, &v) in q.iter().enumerate() {
             if mask & (1 << i) == 0 {
                 continue;
@@ -304,7 +303,7 @@ impl State<'_> {
             if (v.cert as usize) < init || v.cert_len == 0 {
                 continue;
             }
-            let [a, b] = self.cand[c].pair;
+            let [a, b] = self.table.pairs[c];
             if !self.alive[a as usize] || !self.alive[b as usize] {
                 // Never read again before a reset restores the initial verdicts.
                 let v = &mut self.cand[c].verdict;
@@ -352,26 +351,43 @@ impl State<'_> {
         }
     }
 
+    /// Logs a change that base applies and tree pushes share (polders, dead components):
+    /// always inside a look-ahead tree (`tree`), which undoes its pushes, else as
+    /// [`State::base_log`] (forward mode logs nothing: a relabelled part cost one entry per
+    /// triangle, and the log kept the capacity of the largest).
+    #[inline]
+    pub(super) fn shared_log(&mut self, op: Op, tree: bool) {
+        if tree {
+            self.log.push(op);
+        } else {
+            self.base_log(op);
+        }
+    }
+
     /// Adds `(c, ver)` to the watch list of triangle `t` (logged). In forward mode, where
     /// nothing is undone, a list that doubled is first cleared of the entries of verdicts
     /// since recomputed (those past the initial state's, which a reset brings back).
     fn watch_push(&mut self, t: u32, c: u32, ver: u32) {
-        let list = &mut self.watch[t as usize];
-        if self.forward && list.len() >= 4 && list.len().is_power_of_two() {
-            let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]) as usize;
-            let cand = &self.cand;
-            let mut w = keep;
-            for r in keep..list.len() {
-                let (c2, v2) = list[r];
-                if cand[c2 as usize].cert_ver == v2 {
-                    list[w] = (c2, v2);
-                    w += 1;
-                }
-            }
-            list.truncate(w);
+        if self.forward {
+            let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]);
+            prune(&mut self.watch[t as usize], keep as usize, &self.cand);
         }
-        list.push((c, ver));
+        push_entry(&mut self.watch[t as usize], (c, ver), self.building);
         self.base_log(Op::Watch(t));
+    }
+
+    /// Adds `(c, ver)` to the watch list of dead-component root `v` (logged), pruned as
+    /// [`State::watch_push`] prunes a triangle's.
+    fn root_watch_push(&mut self, v: u32, c: u32, ver: u32) {
+        if self.forward {
+            let keep = self
+                .initial
+                .as_ref()
+                .map_or(0, |i| i.root_watch_len[v as usize]);
+            prune(&mut self.root_watch[v as usize], keep as usize, &self.cand);
+        }
+        push_entry(&mut self.root_watch[v as usize], (c, ver), self.building);
+        self.base_log(Op::RootWatch(v));
     }
 
     /// Moves triangle `t` from `P_old` to `P_new` (logged).
@@ -459,7 +475,7 @@ impl State<'_> {
     #[inline]
     pub fn allowed_count_lazy(&mut self, t: u32) -> u32 {
         if self.alive[t as usize] {
-            for c in self.tri[t as usize].cands {
+            for c in self.table.by_triangle[t as usize] {
                 if c != NONE {
                     self.resolve(c);
                 }
@@ -467,4 +483,37 @@ impl State<'_> {
         }
         self.count[t as usize] as u32
     }
+}
+
+/// Forward mode: when watch list `list` has doubled (from 4 entries on), drops the entries
+/// past `keep` (the initial state's, which a reset brings back) whose verdict was since
+/// recomputed, so that a list holds about twice its live entries at most.
+#[inline]
+fn prune(list: &mut WatchList, keep: usize, cand: &[CandRecord]) {
+    let n = list.len();
+    if n < 4 || !n.is_power_of_two() {
+        return;
+    }
+    let mut w = keep;
+    for r in keep..n {
+        let (c2, v2) = list[r];
+        if cand[c2 as usize].cert_ver == v2 {
+            list[w] = (c2, v2);
+            w += 1;
+        }
+    }
+    list.truncate(w);
+}
+
+/// Pushes onto a watch list. While the initial verdicts are built (`building`) a list's
+/// first block has room for one entry (`ThinVec` starts at four; most lists of a corridor
+/// hold one or two for the whole run), then it doubles; during a run a list grows to four
+/// at once (each reallocation costs more than the room).
+#[inline]
+fn push_entry(list: &mut WatchList, e: (u32, u32), building: bool) {
+    let (len, cap) = (list.len(), list.capacity());
+    if len == cap && cap < 4 {
+        list.reserve_exact(if building && cap == 0 { 1 } else { 4 - len });
+    }
+    list.push(e);
 }
