@@ -24,7 +24,7 @@ pub enum MeshError {
         hint: String,
     },
     #[error(
-        "the mesh is too large: {vertices} vertices, {triangles} triangles (at most 2^32 - 2 vertices, and fewer than 2^32 - 1 element sides: 3 per triangle, 4 per quad)"
+        "the mesh is too large: {vertices} vertices, {triangles} triangles (at most 2^31 - 1 vertices and triangles, and fewer than 2^32 - 1 element sides: 3 per triangle, 4 per quad)"
     )]
     TooLarge { vertices: usize, triangles: usize },
     #[error("node {node} has a non-finite coordinate ({x}, {y}, {z})")]

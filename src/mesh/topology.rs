@@ -203,6 +203,16 @@ fn side_of(tri: [u32; 3], a: u32, b: u32) -> usize {
         .expect("a side of the triangle")
 }
 
+/// Most vertices (and triangles) a mesh may have: below 2^31, since the search state's
+/// certificates tag dead-component roots (vertex ids) with the top bit of a `u32`. (The
+/// element sides must also fit in `u32`: fewer than 2^32 - 1, so triangles stay below 2^31.)
+pub const MAX_VERTICES: usize = (1 << 31) - 1;
+
+/// Whether `nv` vertices and `nt` triangles are within [`MAX_VERTICES`].
+fn fits(nv: usize, nt: usize) -> bool {
+    nv <= MAX_VERTICES && nt <= MAX_VERTICES
+}
+
 /// Validates `data` and builds the mesh with its topology.
 pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
     let nv = data.vertices.len();
@@ -213,7 +223,7 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
     if nt == 0 {
         return Err(MeshError::NoTriangles);
     }
-    if nt >= NONE as usize || nv >= NONE as usize {
+    if !fits(nv, nt) {
         return Err(MeshError::TooLarge {
             vertices: nv,
             triangles: nt,
@@ -483,6 +493,15 @@ fn log10_height(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_size_limit_is_the_search_states() {
+        // The state asserted fewer than 2^31 vertices while the reader accepted up to
+        // 2^32 - 2: a mesh in between would have panicked instead of being refused.
+        assert!(super::fits(super::MAX_VERTICES, 1));
+        assert!(!super::fits(super::MAX_VERTICES + 1, 1));
+        assert!(!super::fits(3, super::MAX_VERTICES + 1));
+    }
+
     use super::*;
 
     /// Two triangles sharing the diagonal of the unit square, second one given with `order`.

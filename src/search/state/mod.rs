@@ -108,6 +108,8 @@ const LINKED: u8 = 1 << 7;
 /// Tag of a dead-component root in a triangle certificate (vertex and triangle ids stay
 /// below it).
 const ROOT_TAG: u32 = 1 << 31;
+// Every mesh the reader accepts has its vertex and triangle ids below the tag.
+const _: () = assert!(crate::mesh::topology::MAX_VERTICES < ROOT_TAG as usize);
 
 /// A split verdict, listed (`KIND_SPLIT`) or long (`KIND_SPLIT_LONG`).
 #[inline]
