@@ -28,7 +28,7 @@ impl State<'_> {
     /// The subtree sizes of every acyclic component, or `None` when no component is acyclic
     /// (or has more than one triangle, so a pair). O(n), breadth first.
     pub(super) fn acyclic_parts(&self) -> Option<Acyclic> {
-        let nt = self.tri.len();
+        let nt = self.alive.len();
         let mut parent = vec![NONE; nt];
         let mut size = vec![0u32; nt];
         let mut component = vec![0u32; nt];

@@ -1,10 +1,10 @@
-//! Building the state: the per-candidate and per-triangle records laid out for the
+//! Building the state: the per-candidate records and the dense dual graph laid out for the
 //! criterion, the buckets, polders and `P_k` sets, and every initial verdict with its
 //! certificate ([`State::new`]).
 
 use super::pk::OrderedSets;
 use super::tree::Overlay;
-use super::{CandRecord, ROOT_TAG, State, TriRecord, Verdict, WatchList};
+use super::{CandRecord, ROOT_TAG, State, Verdict, WatchList};
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 
@@ -130,29 +130,11 @@ impl<'a> State<'a> {
             })
             .collect();
         drop((fill, cand_nb));
-        let tri: Vec<TriRecord> = (0..nt)
-            .map(|t| {
-                let tri = mesh.triangles[t];
-                let mut r = [tri[0], tri[1], tri[2], NONE, NONE, NONE];
-                for i in 0..3 {
-                    let u = nb[t][i];
-                    if u != NONE {
-                        let (a, b) = (tri[i], tri[(i + 1) % 3]);
-                        r[3 + i] = mesh.triangles[u as usize]
-                            .into_iter()
-                            .find(|&x| x != a && x != b)
-                            .unwrap_or(NONE);
-                    }
-                }
-                TriRecord { ring: r }
-            })
-            .collect();
         let mut st = State {
             mesh,
             table,
             closed,
             cand,
-            tri,
             dual,
             vc_start,
             vc_list,

@@ -232,8 +232,8 @@ impl State<'_> {
         for s in 0..ns {
             self.nseed[s] = self.queue[s].len();
         }
-        // The dense dual graph, not the triangle records: a search streams through many
-        // triangles and reads only their neighbours (a quarter of the bytes).
+        // The dense dual graph: a search streams through many
+        // triangles and reads only their neighbours.
         let nb = &self.dual[..];
         loop {
             // The verdict can only change when a search runs dry or two groups meet.

@@ -40,11 +40,12 @@
 //!   else recomputed. `P_min` inside the tree (rare) is the base sets corrected by the
 //!   triangles the path can have changed.
 //! * **Layout.** What is read together is stored together: one 40-byte record per candidate
-//!   (the quad's neighbours, verdict, its version and stale mark) and one per triangle (its
-//!   ring of vertices); the quad, the pair and each triangle's candidates are read from the
-//!   table, not repeated (memory: a 64-byte candidate record with them cost 80 bytes per
-//!   triangle of a grid); the lockstep search, which streams through many triangles for
-//!   their neighbours only, reads a dense dual graph.
+//!   (the quad's neighbours, verdict, its version and stale mark); the quad, the pair and
+//!   each triangle's candidates are read from the table and a triangle's vertices from the
+//!   mesh, not repeated (memory: a 64-byte candidate record with them cost 80 bytes per
+//!   triangle of a grid, a triangle record of its ring of six vertices 24); the lockstep
+//!   search, which streams through many triangles for their neighbours only, reads a dense
+//!   dual graph.
 //!
 //! # Files
 //! This module holds the records, the [`State`] struct and its read-only accessors;
@@ -137,16 +138,6 @@ struct CandRecord {
 }
 const _: () = assert!(std::mem::size_of::<CandRecord>() == 40);
 
-/// Per triangle, in one record: what `apply` and the trees read about it. The triangle
-/// across each side is in the state's dense `dual` (kept once: the searches stream through
-/// it), the candidate across each side in the table's `by_triangle` (not repeated here).
-#[derive(Debug, Clone, Copy)]
-struct TriRecord {
-    /// Its vertices, then the vertex across each of its sides (NONE without a neighbour):
-    /// every vertex of every quad it can be part of.
-    ring: [u32; 6],
-}
-
 /// Owner mark for the two triangles being removed during a search.
 const BLOCKED: u32 = 7;
 /// Search mark of a used triangle: above every epoch's marks, so one comparison tells an
@@ -238,8 +229,6 @@ pub struct State<'a> {
     closed: Vec<bool>,
     /// Per candidate: its quad's neighbours, verdict, version, stale mark.
     cand: Vec<CandRecord>,
-    /// Per triangle: its ring of vertices.
-    tri: Vec<TriRecord>,
     /// The candidates' dual graph as a dense array (the triangle across each side through a
     /// candidate, or NONE), which the lockstep searches stream through.
     dual: Vec<[u32; 3]>,
@@ -371,8 +360,7 @@ impl<'a> State<'a> {
     /// The vertices of triangle `t` (as in the mesh).
     #[inline]
     fn verts(&self, t: u32) -> [u32; 3] {
-        let r = &self.tri[t as usize].ring;
-        [r[0], r[1], r[2]]
+        self.mesh.triangles[t as usize]
     }
 
     /// The candidate across each side of triangle `t` (the table's `by_triangle[t]`).

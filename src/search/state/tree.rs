@@ -228,11 +228,16 @@ impl State<'_> {
                 if !self.alive[t as usize] {
                     continue;
                 }
+                // Every vertex of every quad `t` can be part of: its own and its
+                // candidates' quads'.
                 let keep = slot.local
-                    && self.tri[t as usize]
-                        .ring
-                        .iter()
-                        .all(|&v| v == NONE || tr.touched_at[v as usize] != here);
+                    && (self.verts(t).iter()).all(|&v| tr.touched_at[v as usize] != here)
+                    && (self.table.by_triangle[t as usize].iter())
+                        .filter(|&&c| c != NONE)
+                        .all(|&c| {
+                            (self.table.quads[c as usize].iter())
+                                .all(|&v| tr.touched_at[v as usize] != here)
+                        });
                 let slot = if keep { slot } else { self.count_local(t) };
                 self.tree.slots.push(slot);
             }

@@ -259,8 +259,8 @@ impl State<'_> {
             // Walk around v: leave each triangle across its other edge at v.
             let (mut t, mut prev) = (start, NONE);
             for _ in 0..64 {
-                let r = &self.tri[t as usize];
-                let k = r.ring[..3]
+                let k = self
+                    .verts(t)
                     .iter()
                     .position(|&x| x == v)
                     .expect("v is a corner");
