@@ -92,23 +92,6 @@ impl<'a> State<'a> {
         // The build's scratch goes before the initial verdicts, which set the state's peak
         // (on corridors, where the state is all there is).
         drop((vt_count, vt_first, has_quad));
-        let mut vc_start = vec![0u32; nv + 1];
-        for q in &table.quads {
-            for &v in q {
-                vc_start[v as usize + 1] += 1;
-            }
-        }
-        for v in 0..nv {
-            vc_start[v + 1] += vc_start[v];
-        }
-        let mut fill = vc_start.clone();
-        let mut vc_list = vec![0u32; vc_start[nv] as usize];
-        for (c, q) in table.quads.iter().enumerate() {
-            for &v in q {
-                vc_list[fill[v as usize] as usize] = c as u32;
-                fill[v as usize] += 1;
-            }
-        }
         let cand: Vec<CandRecord> = (0..m)
             .map(|c| {
                 let (quad, nb) = (table.quads[c], cand_nb[c]);
@@ -129,15 +112,13 @@ impl<'a> State<'a> {
                 l
             })
             .collect();
-        drop((fill, cand_nb));
+        drop(cand_nb);
         let mut st = State {
             mesh,
             table,
             closed,
             cand,
             dual,
-            vc_start,
-            vc_list,
             alive: vec![true; nt],
             remaining: nt as u32,
             count: vec![0; nt],
@@ -180,6 +161,7 @@ impl<'a> State<'a> {
             changed: Vec::new(),
             moved: Vec::new(),
             fan: Vec::new(),
+            at_vertex: Vec::new(),
             shrunk: Vec::new(),
             y_roots: Vec::new(),
             attached: Vec::new(),

@@ -68,7 +68,7 @@ mod tree_cache;
 mod undo;
 mod verdicts;
 
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 pub use audit::{TreeAudit, TreeEvent, TreeView};
 pub use oracle::naive_allowed;
@@ -232,9 +232,6 @@ pub struct State<'a> {
     /// The candidates' dual graph as a dense array (the triangle across each side through a
     /// candidate, or NONE), which the lockstep searches stream through.
     dual: Vec<[u32; 3]>,
-    /// Candidates whose quad has vertex `v` (CSR).
-    vc_start: Vec<u32>,
-    vc_list: Vec<u32>,
     // ---- dynamic ----
     alive: Vec<bool>,
     remaining: u32,
@@ -305,6 +302,8 @@ pub struct State<'a> {
     moved: Vec<u32>,
     /// Fan triangles for [`State::shrink_split`].
     fan: Vec<u32>,
+    /// Candidates at a vertex ([`State::candidates_at`]) for `apply`.
+    at_vertex: Vec<u32>,
     /// Candidates whose split verdict the current `apply` kept by `shrink_split`.
     shrunk: Vec<u32>,
     /// The dead components an action's distinct-components proof saw (roots before its
@@ -361,6 +360,40 @@ impl<'a> State<'a> {
     #[inline]
     fn verts(&self, t: u32) -> [u32; 3] {
         self.mesh.triangles[t as usize]
+    }
+
+    /// Appends to `out` every candidate whose quad has vertex `v`, whose fan is closed
+    /// (`closed[v]`), from `start`, a triangle of the fan: the candidates of the fan's
+    /// triangles, walked through the dual graph (each has `v` in its quad, and every quad
+    /// with `v` has a triangle in the fan), each once: per triangle, the pair across its
+    /// side opposite `v` and the pair with the next triangle of the walk. Takes the place
+    /// of a vertex-to-candidate list (16 bytes per candidate).
+    fn candidates_at(&self, v: u32, start: u32, out: &mut Vec<u32>) {
+        debug_assert!(self.closed[v as usize]);
+        let (mut t, mut prev) = (start, NONE);
+        loop {
+            let k = (self.verts(t).iter())
+                .position(|&x| x == v)
+                .expect("v is a corner of its fan's triangles");
+            // Sides at v: side k is (tri[k], tri[k+1]), side k-1 is (tri[k-1], tri[k]);
+            // side k+1 is opposite v.
+            let cands = &self.table.by_triangle[t as usize];
+            let nb = &self.dual[t as usize];
+            let opposite = cands[(k + 1) % 3];
+            if opposite != NONE {
+                out.push(opposite);
+            }
+            let side = if nb[k] != prev { k } else { (k + 2) % 3 };
+            let next = nb[side];
+            debug_assert_ne!(next, NONE, "a closed fan");
+            // The dual graph joins candidates' pairs only: a candidate across `side`.
+            out.push(cands[side]);
+            prev = t;
+            t = next;
+            if t == start {
+                return;
+            }
+        }
     }
 
     /// The candidate across each side of triangle `t` (the table's `by_triangle[t]`).

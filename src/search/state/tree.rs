@@ -548,9 +548,15 @@ impl State<'_> {
                     }
                 }
             }
+            // Only a closed fan's vertex can be clean, so only there can a candidate's
+            // verdict depend on its vertex staying clean (its other dependencies are
+            // watched, as in `apply`).
+            let [a, b] = self.table.pairs[c as usize];
             for v in self.table.quads[c as usize] {
-                let v = v as usize;
-                out.extend(&self.vc_list[self.vc_start[v] as usize..self.vc_start[v + 1] as usize]);
+                if self.closed[v as usize] {
+                    let start = if self.verts(a).contains(&v) { a } else { b };
+                    self.candidates_at(v, start, out);
+                }
             }
         }
         for op in &self.log[tr.log_start..] {

@@ -135,15 +135,19 @@ impl State<'_> {
                 }
             }
         }
+        let mut at = std::mem::take(&mut self.at_vertex);
         for i in 0..self.moved.len() {
-            let v = self.moved[i] as usize;
-            for j in self.vc_start[v]..self.vc_start[v + 1] {
-                let c2 = self.vc_list[j as usize];
+            let v = self.moved[i];
+            let start = if self.verts(t0).contains(&v) { t0 } else { t1 };
+            at.clear();
+            self.candidates_at(v, start, &mut at);
+            for &c2 in &at {
                 if self.is_live(c2) {
                     self.mark(c2);
                 }
             }
         }
+        self.at_vertex = at;
         // Split verdicts exact before this action, which had a local proof and lies inside
         // one of their parts, are kept at once (`shrink_split`) instead of being marked:
         // in lazy mode they would otherwise be searched again when next read.
