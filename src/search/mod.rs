@@ -204,18 +204,9 @@ impl<'a> Searcher<'a> {
         }
     }
 
-    /// Builds the state and the eta order for `mesh` and `table`.
+    /// A searcher for `mesh` and `table` (the state and the eta order are built when a run
+    /// first needs them).
     pub fn new(mesh: &'a Mesh, table: &'a CandidateTable) -> Searcher<'a> {
-        let mut order: Vec<u32> = (0..table.len() as u32).collect();
-        order.sort_by(|&a, &b| {
-            table.eta[b as usize]
-                .total_cmp(&table.eta[a as usize])
-                .then(a.cmp(&b))
-        });
-        let mut rank = vec![0u32; order.len()];
-        for (i, &c) in order.iter().enumerate() {
-            rank[c as usize] = i as u32;
-        }
         Searcher {
             state: LazyState {
                 mesh,
@@ -223,8 +214,8 @@ impl<'a> Searcher<'a> {
                 state: None,
                 audit: None,
             },
-            order,
-            rank,
+            order: Vec::new(),
+            rank: Vec::new(),
             revisit: std::collections::BinaryHeap::new(),
             cursor: 0,
             rng: ChaCha8Rng::seed_from_u64(0),
@@ -237,6 +228,25 @@ impl<'a> Searcher<'a> {
             used: vec![false; mesh.num_triangles()],
             progress: None,
             started: Instant::now(),
+        }
+    }
+
+    /// Builds the eta order and ranks (candidates by decreasing eta, ties by increasing
+    /// index) unless built: for the policies that read them, before their run's clock.
+    fn eta_order(&mut self) {
+        let table = self.state.table;
+        if self.order.len() == table.len() {
+            return;
+        }
+        self.order = (0..table.len() as u32).collect();
+        self.order.sort_by(|&a, &b| {
+            table.eta[b as usize]
+                .total_cmp(&table.eta[a as usize])
+                .then(a.cmp(&b))
+        });
+        self.rank = vec![0u32; self.order.len()];
+        for (i, &c) in self.order.iter().enumerate() {
+            self.rank[c as usize] = i as u32;
         }
     }
 
@@ -262,6 +272,9 @@ impl<'a> Searcher<'a> {
         let info = algo.info();
         if info.builds_trees {
             self.state.fresh();
+        }
+        if info.policy.reads_eta_order() {
+            self.eta_order();
         }
         self.cursor = 0;
         self.nodes = 0;

@@ -26,6 +26,10 @@ impl Policy for Greedy {
         (s.nodes, s.trees) = (quads, quads);
         s.state.chosen().to_vec()
     }
+
+    fn reads_eta_order(&self) -> bool {
+        true
+    }
 }
 
 impl Searcher<'_> {

@@ -26,6 +26,10 @@ impl Policy for GreedyNocrit {
         s.trees = chosen.len() as u64;
         chosen
     }
+
+    fn reads_eta_order(&self) -> bool {
+        true
+    }
 }
 
 impl Searcher<'_> {

@@ -51,6 +51,13 @@ pub fn names() -> impl Iterator<Item = &'static str> {
 pub trait Policy: Sync + fmt::Debug {
     /// One run with parameters `p` (each parameter of the method's [`Info::params`] set).
     fn run(&self, s: &mut Searcher<'_>, p: Params) -> Vec<u32>;
+
+    /// Whether its runs read the candidates in decreasing eta (the searcher's eta order
+    /// and ranks, 8 bytes per candidate, built before the run's clock starts only for the
+    /// policies that say so).
+    fn reads_eta_order(&self) -> bool {
+        false
+    }
 }
 
 /// What a method is, for everything that is not the search itself.

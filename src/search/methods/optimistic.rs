@@ -143,4 +143,8 @@ impl Policy for Optimistic {
         });
         s.state.chosen().to_vec()
     }
+
+    fn reads_eta_order(&self) -> bool {
+        true
+    }
 }

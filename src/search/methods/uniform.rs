@@ -27,6 +27,10 @@ impl Policy for Uniform {
         s.trees = s.state.quads() as u64;
         s.state.chosen().to_vec()
     }
+
+    fn reads_eta_order(&self) -> bool {
+        true
+    }
 }
 
 impl Searcher<'_> {

@@ -297,7 +297,9 @@ impl State<'_> {
     pub(super) fn compact_base_cert(&mut self) {
         debug_assert!(self.forward, "undo logs refer to arena offsets");
         let init = self.cert_floor();
-        let mut live: Vec<(u32, u32)> = Vec::new();
+        // Candidate ids (4 bytes each: the list is live at the arena's peak), sorted by
+        // their certificate's offset, which is each live verdict's own.
+        let mut live: Vec<u32> = Vec::new();
         for c in 0..self.cand.len() {
             let v = self.cand[c].verdict;
             if (v.cert as usize) < init || v.cert_len == 0 {
@@ -310,13 +312,13 @@ impl State<'_> {
                 (v.cert, v.cert_len) = (0, 0);
                 continue;
             }
-            live.push((v.cert, c as u32));
+            live.push(c as u32);
         }
-        live.sort_unstable();
+        live.sort_unstable_by_key(|&c| self.cand[c as usize].verdict.cert);
         let mut end = init;
-        for (off, c) in live {
+        for c in live {
             let v = &mut self.cand[c as usize].verdict;
-            let len = v.cert_len as usize;
+            let (off, len) = (v.cert, v.cert_len as usize);
             self.base_cert
                 .copy_within(off as usize..off as usize + len, end);
             v.cert = end as u32;
