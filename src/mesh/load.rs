@@ -132,17 +132,10 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
 
 impl Source {
     /// Parses and validates the mesh, its elements in spatial order ([`order::spatial`]: the
-    /// searches run faster on it; node and element tags are kept).
-    /// Keeps the bytes; [`Source::into_mesh`] frees them before the mesh is built.
-    pub fn mesh(&self) -> Result<Mesh, ReadError> {
-        let mut file = msh::parse(&self.path, &self.bytes)?;
-        order::spatial(&mut file.data);
-        file.into_mesh(&self.path)
-    }
-
-    /// As [`Source::mesh`], but the file's bytes are freed as soon as they are parsed, before
-    /// the spatial order and the topology are built (they were the largest part of the
-    /// load's peak memory: the whole file, alive until the mesh was done).
+    /// searches run faster on it; node and element tags are kept). The file's bytes are
+    /// freed as soon as they are parsed, before the spatial order and the topology are built
+    /// (they were the largest part of the load's peak memory: the whole file, alive until
+    /// the mesh was done).
     pub fn into_mesh(self) -> Result<Mesh, ReadError> {
         let Source { path, bytes, .. } = self;
         let mut file = msh::parse(&path, &bytes)?;
