@@ -232,8 +232,8 @@ impl State<'_> {
         for s in 0..ns {
             self.nseed[s] = self.queue[s].len();
         }
-        // The dense dual graph: a search streams through many
-        // triangles and reads only their neighbours.
+        // The dense dual graph: a search streams through many triangles and reads only
+        // their neighbours.
         let nb = &self.dual[..];
         loop {
             // The verdict can only change when a search runs dry or two groups meet.
@@ -471,8 +471,8 @@ impl State<'_> {
     }
 
     /// After a [`State::check`] that found a split of the polder of `t0`: gives each
-    /// finished part a new polder id (logged as [`State::union`] is) and the rest (the running part, or the largest
-    /// when all finished) the old id with its new size. The ids whose size changed parity
+    /// finished part a new polder id (logged as [`State::union`] is) and the rest (the
+    /// running part, or the largest when all finished) the old id with its new size. The ids whose size changed parity
     /// are left in `changed`.
     pub(super) fn relabel_split(&mut self, t0: u32, tree: bool) {
         let p = self.polder[t0 as usize];

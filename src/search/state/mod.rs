@@ -362,6 +362,28 @@ impl<'a> State<'a> {
         self.mesh.triangles[t as usize]
     }
 
+    /// The triangle of `pair` that has vertex `v` (the first when both have it): where a
+    /// walk around `v` starts.
+    #[inline]
+    fn corner_of(&self, [a, b]: [u32; 2], v: u32) -> u32 {
+        if self.verts(a).contains(&v) { a } else { b }
+    }
+
+    /// One step of a walk around vertex `v` through the dual graph, in triangle `t`
+    /// (arrived from `prev`, `NONE` at the start): the side `t` is left by (the side at `v`
+    /// not towards `prev`), the triangle across it (`NONE` where the fan is open) and the
+    /// index of `v` in `t`. Sides at `v`: side k (tri[k], tri[k+1]) and side k-1; side k+1
+    /// is opposite `v`.
+    #[inline]
+    fn fan_step(&self, t: u32, v: u32, prev: u32) -> (usize, u32, usize) {
+        let k = (self.verts(t).iter())
+            .position(|&x| x == v)
+            .expect("v is a corner of its fan's triangles");
+        let nb = &self.dual[t as usize];
+        let side = if nb[k] != prev { k } else { (k + 2) % 3 };
+        (side, nb[side], k)
+    }
+
     /// Appends to `out` every candidate whose quad has vertex `v`, whose fan is closed
     /// (`closed[v]`), from `start`, a triangle of the fan: the candidates of the fan's
     /// triangles, walked through the dual graph (each has `v` in its quad, and every quad
@@ -372,20 +394,13 @@ impl<'a> State<'a> {
         debug_assert!(self.closed[v as usize]);
         let (mut t, mut prev) = (start, NONE);
         loop {
-            let k = (self.verts(t).iter())
-                .position(|&x| x == v)
-                .expect("v is a corner of its fan's triangles");
-            // Sides at v: side k is (tri[k], tri[k+1]), side k-1 is (tri[k-1], tri[k]);
-            // side k+1 is opposite v.
+            let (side, next, k) = self.fan_step(t, v, prev);
+            debug_assert_ne!(next, NONE, "a closed fan");
             let cands = &self.table.by_triangle[t as usize];
-            let nb = &self.dual[t as usize];
             let opposite = cands[(k + 1) % 3];
             if opposite != NONE {
                 out.push(opposite);
             }
-            let side = if nb[k] != prev { k } else { (k + 2) % 3 };
-            let next = nb[side];
-            debug_assert_ne!(next, NONE, "a closed fan");
             // The dual graph joins candidates' pairs only: a candidate across `side`.
             out.push(cands[side]);
             prev = t;

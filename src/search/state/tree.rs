@@ -551,11 +551,10 @@ impl State<'_> {
             // Only a closed fan's vertex can be clean, so only there can a candidate's
             // verdict depend on its vertex staying clean (its other dependencies are
             // watched, as in `apply`).
-            let [a, b] = self.table.pairs[c as usize];
+            let pair = self.table.pairs[c as usize];
             for v in self.table.quads[c as usize] {
                 if self.closed[v as usize] {
-                    let start = if self.verts(a).contains(&v) { a } else { b };
-                    self.candidates_at(v, start, out);
+                    self.candidates_at(v, self.corner_of(pair, v), out);
                 }
             }
         }

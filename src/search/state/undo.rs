@@ -138,7 +138,7 @@ impl State<'_> {
         let mut at = std::mem::take(&mut self.at_vertex);
         for i in 0..self.moved.len() {
             let v = self.moved[i];
-            let start = if self.verts(t0).contains(&v) { t0 } else { t1 };
+            let start = self.corner_of([t0, t1], v);
             at.clear();
             self.candidates_at(v, start, &mut at);
             for &c2 in &at {

@@ -255,19 +255,11 @@ impl State<'_> {
             if mask & (1 << i) == 0 {
                 continue;
             }
-            let start = if self.verts(a).contains(&v) { a } else { b };
+            let start = self.corner_of([a, b], v);
             // Walk around v: leave each triangle across its other edge at v.
             let (mut t, mut prev) = (start, NONE);
             for _ in 0..64 {
-                let k = self
-                    .verts(t)
-                    .iter()
-                    .position(|&x| x == v)
-                    .expect("v is a corner");
-                // Edges at v: (tri[k], tri[k+1]) is side k, (tri[k-1], tri[k]) side k-1.
-                let nb = &self.dual[t as usize];
-                let (s1, s2) = (nb[k], nb[(k + 2) % 3]);
-                let next = if s1 != prev { s1 } else { s2 };
+                let (_, next, _) = self.fan_step(t, v, prev);
                 if next == NONE {
                     return false;
                 }
