@@ -4,7 +4,7 @@
 
 use super::pk::OrderedSets;
 use super::tree::Overlay;
-use super::{CandRecord, ROOT_TAG, State, Verdict, WatchList};
+use super::{ACTIVE, CandRecord, ROOT_TAG, State, Verdict, WatchList, parity};
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 
@@ -23,6 +23,10 @@ impl<'a> State<'a> {
         // (those sides are boundaries for the criterion, like a surface's).
         let dual = table.dual_graph();
         let (polder, polder_size) = CandidateTable::components(&dual);
+        // Edge weights for telling a part's parity without enumerating it, on the meshes
+        // the argument covers; the triangles of odd initial polders do not count.
+        let even = |t: u32| polder_size[polder[t as usize] as usize] % 2 == 0;
+        let weights = parity::edge_weights(mesh, even);
         let nb = &dual;
         let cand_nb: Vec<[u32; 4]> = (0..m)
             .map(|c| {
@@ -101,8 +105,28 @@ impl<'a> State<'a> {
                     cert_ver: 0,
                     flags: 0,
                     shared: false,
+                    par: 0,
                     dirty: false,
                 };
+                if let Some(w) = &weights {
+                    // Side i of the quad joins its vertices i and i + 1, in one of the pair.
+                    let [t0, t1] = table.pairs[c];
+                    for i in 0..4 {
+                        let (a, b) = (quad[i], quad[(i + 1) % 4]);
+                        let bit =
+                            parity::weight_of(mesh.triangles[t0 as usize], w[t0 as usize], a, b)
+                                | parity::weight_of(
+                                    mesh.triangles[t1 as usize],
+                                    w[t1 as usize],
+                                    a,
+                                    b,
+                                );
+                        l.par |= bit << i;
+                    }
+                    if even(t0) {
+                        l.par |= ACTIVE;
+                    }
+                }
                 for i in 0..4 {
                     if closed[quad[i] as usize] {
                         l.flags |= 1 << i;
@@ -133,6 +157,9 @@ impl<'a> State<'a> {
             watch: (0..nt).map(|_| WatchList::new()).collect(),
             dsu_parent: (0..nv as u32).collect(),
             dsu_size: vec![1; nv],
+            dsu_par: vec![0; nv],
+            odd_active: 0,
+            need_parts: false,
             root_watch: (0..nv).map(|_| WatchList::new()).collect(),
             arc_roots: [NONE; 4],
             narcs: 0,
@@ -167,20 +194,23 @@ impl<'a> State<'a> {
             attached: Vec::new(),
             searches: 0,
             searched: 0,
+            parity_splits: 0,
             split_shrinks: 0,
         };
         // The removed region at the start: boundary edges (mesh, surface and quad
         // boundaries: dual sides without a neighbour) and input quads.
         for (t, tri) in mesh.triangles.iter().enumerate() {
+            let w = weights.as_ref().map_or(0, |w| w[t]);
             for i in 0..3 {
                 if st.dual[t][i] == NONE {
-                    st.union(tri[i], tri[(i + 1) % 3], false);
+                    st.union(tri[i], tri[(i + 1) % 3], (w >> i) & 1, false);
                 }
             }
         }
+        drop(weights);
         for q in &mesh.quads {
             for i in 1..4 {
-                st.union(q[0], q[i], false);
+                st.union(q[0], q[i], 0, false);
             }
         }
         // Components without a cycle (corridors) all at once; a search per candidate

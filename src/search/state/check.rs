@@ -27,8 +27,8 @@ const LOCAL_OK: [bool; 256] = {
 };
 
 use super::{
-    BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT, KIND_SPLIT_LONG,
-    LINKED, LONG_PART, Op, ROOT_TAG, State, Verdict,
+    ACTIVE, BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT,
+    KIND_SPLIT_LONG, LINKED, LONG_PART, Op, ROOT_TAG, State, Verdict,
 };
 use crate::mesh::NONE;
 
@@ -137,6 +137,7 @@ impl State<'_> {
         // vertex and the one after its last: a clean vertex's edges are live). A split
         // needs one dead component to touch the quad twice.
         let mut arc_link = [(0usize, 0usize); 4];
+        let mut arc_at = [0usize; 4];
         let mut distinct = true;
         for i in 0..4 {
             let prev = (i + 3) % 4;
@@ -153,6 +154,7 @@ impl State<'_> {
                     j = (j + 1) % 4;
                 }
                 arc_link[self.narcs] = (prev, j);
+                arc_at[self.narcs] = i;
                 self.arc_roots[self.narcs] = r;
                 self.narcs += 1;
             }
@@ -190,6 +192,23 @@ impl State<'_> {
                 linked = true;
             }
         }
+        // Two groups, separated by the one dead component the quad touches twice (the others
+        // touch it once): on a sphere with holes they are two parts, and the path of dead
+        // edges between the two arcs closes, with the quad's sides between them, into a
+        // curve around one part whose triangles number the parity of its edge weights
+        // ([`super::parity`]). The polder is even (none that was is odd), so the other
+        // part has the same parity, and the verdict is that of a long split certified by
+        // both groups' seeds.
+        let twice = if ns == 2
+            && !self.need_parts
+            && self.odd_active == 0
+            && self.cand[c as usize].par & ACTIVE != 0
+            && !self.cand[c as usize].shared
+        {
+            self.arcs_twice()
+        } else {
+            None
+        };
         if !linked {
             self.narcs = 0;
         }
@@ -200,6 +219,33 @@ impl State<'_> {
             mask: vmask,
             ..Verdict::default()
         };
+        if let Some((a, b)) = twice {
+            let (i, j) = (arc_at[a], arc_at[b]);
+            let odd = self.find_par(q[i]).1 ^ self.find_par(q[j]).1 ^ self.quad_path(c, i, j);
+            let total = self.polder_size[self.polder[t0 as usize] as usize];
+            debug_assert_eq!(total % 2, 0, "an active polder is even");
+            self.parity_splits += 1;
+            self.nsearch = ns;
+            for s in 0..ns {
+                self.queue[s].clear();
+                self.group[s] = s as u8;
+                self.finished[s] = true;
+            }
+            for i in 0..4 {
+                if live[i] {
+                    self.queue[sid[root[i] as usize] as usize].push(n[i]);
+                }
+            }
+            for s in 0..ns {
+                self.nseed[s] = self.queue[s].len();
+                self.cert_len[s] = self.nseed[s];
+            }
+            return Verdict {
+                fin_odd: 2 * odd,
+                fin_known: total - 2,
+                ..verdict(odd == 0, KIND_SPLIT_LONG)
+            };
+        }
         self.searches += 1;
         self.epoch += 1;
         if self.epoch > EPOCH_LIMIT {
@@ -319,6 +365,28 @@ impl State<'_> {
                 };
             }
         }
+    }
+
+    /// The two arcs (indices, in quad order) of the one dead component that touches the
+    /// quad twice, when every other arc's component touches it once.
+    fn arcs_twice(&self) -> Option<(usize, usize)> {
+        let roots = &self.arc_roots[..self.narcs];
+        let mut twice = None;
+        for a in 0..roots.len() {
+            let same = roots.iter().filter(|&&r| r == roots[a]).count();
+            if same > 2 {
+                return None;
+            }
+            if same == 2 {
+                let b = (a + 1..roots.len()).find(|&b| roots[b] == roots[a]);
+                match (twice, b) {
+                    (None, Some(b)) => twice = Some((a, b)),
+                    (Some((x, _)), _) if roots[x] == roots[a] => {}
+                    _ => return None,
+                }
+            }
+        }
+        twice
     }
 
     /// Per group (indexed by its root search) of the current searches: triangles visited,
@@ -441,11 +509,24 @@ impl State<'_> {
         v
     }
 
-    /// Joins the dead components of `a` and `b` (logged inside a look-ahead tree, `tree`,
-    /// else as a base change: [`State::shared_log`]); returns the root that was attached
-    /// under the other, if they were distinct.
-    pub(super) fn union(&mut self, a: u32, b: u32, tree: bool) -> Option<u32> {
-        let (mut ra, mut rb) = (self.find(a), self.find(b));
+    /// Root of vertex `v`'s dead component and the parity of the edge weights along the
+    /// union–find's path of dead edges from `v` to it ([`super::parity`]).
+    #[inline]
+    pub(super) fn find_par(&self, mut v: u32) -> (u32, u8) {
+        let mut p = 0;
+        while self.dsu_parent[v as usize] != v {
+            p ^= self.dsu_par[v as usize];
+            v = self.dsu_parent[v as usize];
+        }
+        (v, p)
+    }
+
+    /// Joins the dead components of `a` and `b`, which a path of dead edges of weight
+    /// parity `w` joins (logged inside a look-ahead tree, `tree`, else as a base change:
+    /// [`State::shared_log`]); returns the root that was attached under the other, if they
+    /// were distinct.
+    pub(super) fn union(&mut self, a: u32, b: u32, w: u8, tree: bool) -> Option<u32> {
+        let ((mut ra, pa), (mut rb, pb)) = (self.find_par(a), self.find_par(b));
         if ra == rb {
             return None;
         }
@@ -453,6 +534,7 @@ impl State<'_> {
             std::mem::swap(&mut ra, &mut rb);
         }
         self.dsu_parent[rb as usize] = ra;
+        self.dsu_par[rb as usize] = pa ^ pb ^ w;
         self.dsu_size[ra as usize] += self.dsu_size[rb as usize];
         self.shared_log(
             Op::Union {
@@ -464,17 +546,36 @@ impl State<'_> {
         Some(rb)
     }
 
+    /// The parity of the edge weights along candidate `c`'s quad sides from its vertex
+    /// `from` to its vertex `to` (`from <= to`), forwards: sides `from..to`.
+    #[inline]
+    pub(super) fn quad_path(&self, c: u32, from: usize, to: usize) -> u8 {
+        let sides = (1u8 << to) - (1u8 << from);
+        ((self.cand[c as usize].par & sides).count_ones() & 1) as u8
+    }
+
+    /// [`State::check`], searching whatever the verdict: the parts of a split are left for
+    /// [`State::relabel_split`].
+    pub(super) fn check_parts(&mut self, c: u32) -> Verdict {
+        self.need_parts = true;
+        let v = self.check(c);
+        self.need_parts = false;
+        v
+    }
+
     fn count_searched(&mut self, ns: usize) {
         for s in 0..ns {
             self.searched += self.queue[s].len() as u64;
         }
     }
 
-    /// After a [`State::check`] that found a split of the polder of `t0`: gives each
+    /// After a [`State::check_parts`] that found a split of candidate `c`'s polder: gives each
     /// finished part a new polder id (logged as [`State::union`] is) and the rest (the
     /// running part, or the largest when all finished) the old id with its new size. The ids whose size changed parity
     /// are left in `changed`.
-    pub(super) fn relabel_split(&mut self, t0: u32, tree: bool) {
+    pub(super) fn relabel_split(&mut self, c: u32, tree: bool) {
+        let t0 = self.table.pairs[c as usize][0];
+        let changed_before = self.changed.len();
         let p = self.polder[t0 as usize];
         let psize = self.polder_size[p as usize];
         let ns = self.nsearch;
@@ -523,6 +624,13 @@ impl State<'_> {
         }
         self.shared_log(Op::PolderSize { p, old: psize }, tree);
         self.polder_size[p as usize] = rest;
+        // An even polder left an odd part (an action the criterion forbids): parities no
+        // longer tell parts apart ([`super::parity`]) until that is undone.
+        if self.cand[c as usize].par & ACTIVE != 0 && self.changed.len() > changed_before {
+            let old = self.odd_active;
+            self.shared_log(Op::OddActive { old }, tree);
+            self.odd_active = old + 1;
+        }
     }
 }
 

@@ -62,6 +62,7 @@ mod audit;
 mod build;
 mod check;
 mod oracle;
+mod parity;
 mod pk;
 mod tree;
 mod tree_cache;
@@ -133,10 +134,17 @@ struct CandRecord {
     flags: u8,
     /// One triangle neighbours the quad across two of its sides (no local proof then).
     shared: bool,
+    /// Bits 0..4: the edge weights of the quad's sides ([`parity`]); [`ACTIVE`]: its
+    /// polder was even at the start, on a mesh the parity argument covers.
+    par: u8,
     /// The verdict was marked possibly stale by an action and not yet rechecked.
     dirty: bool,
 }
 const _: () = assert!(std::mem::size_of::<CandRecord>() == 40);
+
+/// `CandRecord::par` bit: the candidate's parts can be told apart by parity alone
+/// ([`parity`]).
+const ACTIVE: u8 = 1 << 4;
 
 /// Owner mark for the two triangles being removed during a search.
 const BLOCKED: u32 = 7;
@@ -171,6 +179,8 @@ enum Op {
     SplitRem { c: u32, pos: u32 },
     /// Dead-component root `child` was attached under `root`.
     Union { child: u32, root: u32 },
+    /// [`State::odd_active`] was `old`.
+    OddActive { old: u32 },
     /// A watch entry was pushed onto dead-component root `v`'s list.
     RootWatch(u32),
     /// A candidate was marked stale (pushed on the dirty list).
@@ -212,6 +222,7 @@ struct Initial {
     polder_size: Vec<u32>,
     dsu_parent: Vec<u32>,
     dsu_size: Vec<u32>,
+    dsu_par: Vec<u8>,
     split: Vec<u32>,
     split_pos: Vec<u32>,
     watch_len: Vec<u32>,
@@ -253,6 +264,15 @@ pub struct State<'a> {
     /// connected pieces of the removed region (used triangles, boundaries, input quads).
     dsu_parent: Vec<u32>,
     dsu_size: Vec<u32>,
+    /// Per vertex, the parity of the edge weights ([`parity`]) along a path of dead edges
+    /// to its parent in the union–find.
+    dsu_par: Vec<u8>,
+    /// Odd polders among those that were even at the start (none unless an action the
+    /// criterion forbids was applied): while there are, no verdict is read off parities.
+    odd_active: u32,
+    /// [`State::check`] must search (the parts are relabelled after it), not read a split
+    /// off parities.
+    need_parts: bool,
     /// Verdicts that rely on a dead-component root staying a root.
     root_watch: Vec<WatchList>,
     arc_roots: [u32; 4],
@@ -314,6 +334,8 @@ pub struct State<'a> {
     pub searches: u64,
     /// Number of triangles those searches visited.
     pub searched: u64,
+    /// Splits decided by parity without a search (statistics).
+    pub parity_splits: u64,
     /// Split verdicts kept across an action inside one of their parts instead of a new
     /// search (statistics).
     pub split_shrinks: u64,

@@ -364,7 +364,7 @@ impl State<'_> {
         self.tree.changed_len.push(self.tree.changed.len());
         if split {
             // The parts are needed to relabel them: search again (the smaller parts).
-            let again = self.check(c);
+            let again = self.check_parts(c);
             debug_assert!(is_split(again.kind));
             // Parities are relative to the root: a part of a polder whose parity already
             // changed on the path has changed too, whatever this split does.
@@ -372,7 +372,7 @@ impl State<'_> {
             let inherited = self.tree.changed.contains(&p);
             let first_new = self.polder_size.len() as u32;
             self.changed.clear();
-            self.relabel_split(t0, true);
+            self.relabel_split(c, true);
             self.tree.changed.extend_from_slice(&self.changed);
             if inherited {
                 let tr = &mut self.tree;
@@ -394,7 +394,7 @@ impl State<'_> {
         self.remaining -= 2;
         let q = self.table.quads[ci];
         for i in 1..4 {
-            self.union(q[0], q[i], true);
+            self.union(q[0], q[i], self.quad_path(c, 0, i), true);
         }
         let tr = &mut self.tree;
         tr.next_serial += 1;

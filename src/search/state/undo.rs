@@ -35,7 +35,7 @@ impl State<'_> {
         let v = self.cand[ci].verdict;
         let exact_before = self.dirty_list.is_empty();
         let kept = !self.cand[ci].dirty && v.allowed && !is_split(v.kind);
-        let r = if kept { v } else { self.check(c) };
+        let r = if kept { v } else { self.check_parts(c) };
         let split = is_split(r.kind);
         self.last_local = if exact_before && r.kind == KIND_LOCAL {
             c
@@ -75,7 +75,7 @@ impl State<'_> {
         }
         self.changed.clear();
         if split {
-            self.relabel_split(t0, false);
+            self.relabel_split(c, false);
         } else {
             let p = self.polder[t0 as usize];
             let psize = self.polder_size[p as usize];
@@ -118,7 +118,7 @@ impl State<'_> {
         // The quad joins the dead components at its four vertices.
         let qv = self.table.quads[ci];
         for i in 1..4 {
-            if let Some(child) = self.union(qv[0], qv[i], false) {
+            if let Some(child) = self.union(qv[0], qv[i], self.quad_path(c, 0, i), false) {
                 if distinct {
                     self.attached.push(child);
                 }
@@ -225,7 +225,8 @@ impl State<'_> {
                 | Op::Polder { .. }
                 | Op::PolderNew
                 | Op::PolderSize { .. }
-                | Op::Union { .. } => unreachable!("handled by undo_shared"),
+                | Op::Union { .. }
+                | Op::OddActive { .. } => unreachable!("handled by undo_shared"),
                 Op::Watch(t) => {
                     self.watch[t as usize].pop();
                 }
@@ -297,6 +298,7 @@ impl State<'_> {
                 polder_size: self.polder_size.clone(),
                 dsu_parent: self.dsu_parent.clone(),
                 dsu_size: self.dsu_size.clone(),
+                dsu_par: self.dsu_par.clone(),
                 split: self.split.clone(),
                 split_pos: self.split_pos.clone(),
                 watch_len: self.watch.iter().map(|w| w.len() as u32).collect(),
@@ -341,6 +343,8 @@ impl State<'_> {
         self.polder_size.clone_from(&init.polder_size);
         self.dsu_parent.copy_from_slice(&init.dsu_parent);
         self.dsu_size.copy_from_slice(&init.dsu_size);
+        self.dsu_par.copy_from_slice(&init.dsu_par);
+        self.odd_active = 0;
         self.split.clone_from(&init.split);
         self.split_pos.copy_from_slice(&init.split_pos);
         for (w, &n) in self.watch.iter_mut().zip(&init.watch_len) {
@@ -373,6 +377,7 @@ impl State<'_> {
                 self.polder_size.pop();
             }
             Op::PolderSize { p, old } => self.polder_size[p as usize] = old,
+            Op::OddActive { old } => self.odd_active = old,
             Op::Union { child, root } => {
                 self.dsu_parent[child as usize] = child;
                 self.dsu_size[root as usize] -= self.dsu_size[child as usize];

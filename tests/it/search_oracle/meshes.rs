@@ -256,6 +256,53 @@ pub fn icosphere(subdiv: u32) -> Mesh {
     .expect("valid icosphere")
 }
 
+/// A grid of `nu` by `nv` cells wrapped into a closed surface (each cell two triangles, its
+/// diagonal rising): a torus (genus 1, where a quad that touches one dead component twice
+/// need not cut) with `Wrap::Torus`, an open cylinder (an annulus, genus 0) with
+/// `Wrap::Cylinder`. (A Möbius strip is refused by `Mesh::new`: not orientable.)
+pub fn wrapped(nu: usize, nv: usize, wrap: Wrap) -> Mesh {
+    use std::f64::consts::TAU;
+    let rows = if wrap == Wrap::Torus { nv } else { nv + 1 };
+    let id = |i: usize, j: usize| -> u32 { (i % nu * rows + j % rows) as u32 };
+    let mut vertices = Vec::new();
+    for i in 0..nu {
+        let a = TAU * i as f64 / nu as f64;
+        for j in 0..rows {
+            let p = match wrap {
+                Wrap::Torus => {
+                    let b = TAU * j as f64 / nv as f64;
+                    let r = 2.0 + 0.7 * b.cos();
+                    [r * a.cos(), r * a.sin(), 0.7 * b.sin()]
+                }
+                Wrap::Cylinder => [a.cos(), a.sin(), 0.6 * j as f64 / nv as f64],
+            };
+            vertices.push(p);
+        }
+    }
+    let mut triangles = Vec::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b) = (id(i, j), id(i + 1, j));
+            let (c, d) = (id(i + 1, j + 1), id(i, j + 1));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    Mesh::new(MeshData {
+        vertices,
+        triangles,
+        ..MeshData::default()
+    })
+    .expect("valid wrapped grid")
+}
+
+/// How [`wrapped`] closes its grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wrap {
+    Torus,
+    Cylinder,
+}
+
 /// Twice the signed area of (a, b, c) in the plane.
 fn orient(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])

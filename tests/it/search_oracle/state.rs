@@ -600,3 +600,105 @@ fn soak_policy_runs_match_the_oracle() {
     }
     assert!(checked > 10_000, "{checked} verdicts compared");
 }
+
+#[test]
+fn state_matches_oracle_on_wrapped_grids() {
+    // A torus, where a quad that touches one dead component twice need not cut, so no split
+    // is read off parities (genus 1); a cylinder (genus 0, two boundary loops), where they
+    // are. All the candidates, then those of quads with eta >= 0.5 and random cuts.
+    use meshes::Wrap;
+    let mut total = WalkStats::default();
+    for (name, mesh) in [
+        ("torus 6x4", meshes::wrapped(6, 4, Wrap::Torus)),
+        ("torus 5x6", meshes::wrapped(5, 6, Wrap::Torus)),
+        ("torus 9x3", meshes::wrapped(9, 3, Wrap::Torus)),
+        ("cylinder 7x3", meshes::wrapped(7, 3, Wrap::Cylinder)),
+        ("cylinder 5x4", meshes::wrapped(5, 4, Wrap::Cylinder)),
+    ] {
+        let stats = check_mesh(name, &mesh, 0..16, WalkConfig::default());
+        total.checks += stats.checks;
+        let full = CandidateTable::build(&mesh);
+        let table = full.clone().restrict(&mesh, Rule::Valid { min_eta: 0.5 });
+        check_table(
+            &format!("{name}, eta >= 0.5"),
+            &mesh,
+            &table,
+            0..8,
+            WalkConfig::default(),
+        );
+        let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ 0x7075);
+        for k in 0..8 {
+            let keep: Vec<bool> = (0..full.len()).map(|_| !rng.random_bool(0.2)).collect();
+            let cut = full.clone().retain(&keep);
+            check_table(
+                &format!("{name}, cut {k}"),
+                &mesh,
+                &cut,
+                0..2,
+                WalkConfig::default(),
+            );
+        }
+    }
+    assert!(total.checks > 1000, "{total:?}");
+}
+
+#[test]
+fn state_stays_exact_after_forbidden_actions() {
+    // An action the criterion forbids leaves odd parts of an even polder; parities then no
+    // longer tell a split's parts apart (the state searches again) until it is undone.
+    let mut forbidden = 0;
+    for (name, mesh) in [
+        ("grid 6x6", Grid::plain(6, 6).build().unwrap()),
+        ("grid 7x5 random", {
+            let mut g = Grid::plain(7, 5);
+            g.diagonals = Diagonals::Random;
+            g.seed = SEED;
+            g.build().unwrap()
+        }),
+        ("icosphere 1", meshes::icosphere(1)),
+        (
+            "cylinder 6x3",
+            meshes::wrapped(6, 3, meshes::Wrap::Cylinder),
+        ),
+    ] {
+        let table = CandidateTable::build(&mesh);
+        for seed in 0..6 {
+            let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ seed);
+            let mut state = State::new(&mesh, &table);
+            let mut depth = 0;
+            loop {
+                let live: Vec<u32> = (0..table.len() as u32)
+                    .filter(|&c| state.is_live(c))
+                    .collect();
+                if live.is_empty() {
+                    break;
+                }
+                let banned: Vec<u32> = live
+                    .iter()
+                    .copied()
+                    .filter(|&c| !state.is_allowed(c))
+                    .collect();
+                let c = if !banned.is_empty() && rng.random_bool(0.3) {
+                    forbidden += 1;
+                    banned[rng.random_range(0..banned.len())]
+                } else {
+                    live[rng.random_range(0..live.len())]
+                };
+                state.apply(c);
+                depth += 1;
+                let at = format!("{name} seed {seed}: action {c} at depth {depth}");
+                state
+                    .sanity_check()
+                    .unwrap_or_else(|e| panic!("{at}, applied: {e}"));
+                if depth > 1 && rng.random_bool(0.25) {
+                    state.undo();
+                    depth -= 1;
+                    state
+                        .sanity_check()
+                        .unwrap_or_else(|e| panic!("{at}, undone: {e}"));
+                }
+            }
+        }
+    }
+    assert!(forbidden > 20, "only {forbidden} forbidden actions applied");
+}
