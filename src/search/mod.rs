@@ -99,7 +99,7 @@ impl<'a> LazyState<'a> {
             state.set_forward_uncopied();
             state.set_tree_audit(self.audit);
             // The work counters count the runs' work, not the initial verdicts'.
-            (state.searches, state.searched) = (0, 0);
+            (state.searches, state.searched, state.parity_splits) = (0, 0, 0);
             self.state = Some(state);
         }
     }
@@ -115,12 +115,22 @@ impl<'a> LazyState<'a> {
             state.reset();
             return;
         }
-        let counters = (state.searches, state.searched, state.split_shrinks);
+        let counters = (
+            state.searches,
+            state.searched,
+            state.split_shrinks,
+            state.parity_splits,
+        );
         self.state = None;
         let mut state = State::new(self.mesh, self.table);
         state.set_forward(true);
         state.set_tree_audit(self.audit);
-        (state.searches, state.searched, state.split_shrinks) = counters;
+        (
+            state.searches,
+            state.searched,
+            state.split_shrinks,
+            state.parity_splits,
+        ) = counters;
         self.state = Some(state);
     }
 }

@@ -13,6 +13,10 @@
 //!   manifold) and has no removed triangle, the two quad neighbours meeting at `v` are
 //!   connected through the fan. When these links connect every remaining neighbour, the
 //!   removal disconnects nothing and the action is allowed in O(1) (`dead_count[v] == 0`).
+//! * **Parity by the boundary** (`parity`): on a sphere with holes, a quad that touches one
+//!   dead component twice splits its polder in two, and the parity of the part on one side
+//!   is that of edge weights summed along a path of dead edges and the quad's sides, which
+//!   the union–find keeps per vertex: no search.
 //! * **Lockstep search** otherwise: one breadth-first search per group of neighbours, one
 //!   triangle per search per round; groups merge when they meet; it stops when all groups
 //!   met (one part) or all but one finished. Finished groups are whole parts (sizes known),
@@ -53,7 +57,7 @@
 //! verdicts and their certificates current (recheck, lazy resolution), `undo` applies and
 //! reverts actions through the change log, `check` evaluates the criterion for one
 //! candidate, `oracle` holds the invariant checker and the from-scratch criterion the
-//! tests compare against, and `acyclic`, `pk` and `tree` are described above.
+//! tests compare against, and `acyclic`, `parity`, `pk` and `tree` are described above.
 
 #![allow(clippy::needless_range_loop)] // index loops over the 4 quad sides read best
 
