@@ -23,10 +23,6 @@ impl<'a> State<'a> {
         // (those sides are boundaries for the criterion, like a surface's).
         let dual = table.dual_graph();
         let (polder, polder_size) = CandidateTable::components(&dual);
-        // Edge weights for telling a part's parity without enumerating it, on the meshes
-        // the argument covers; the triangles of odd initial polders do not count.
-        let even = |t: u32| polder_size[polder[t as usize] as usize] % 2 == 0;
-        let weights = parity::edge_weights(mesh, even);
         let nb = &dual;
         let cand_nb: Vec<[u32; 4]> = (0..m)
             .map(|c| {
@@ -59,6 +55,10 @@ impl<'a> State<'a> {
                 vt_first[v as usize] = t as u32;
             }
         }
+        // Edge weights for telling a part's parity without enumerating it, on the meshes
+        // the argument covers; the triangles of odd initial polders do not count.
+        let even = |t: u32| polder_size[polder[t as usize] as usize] % 2 == 0;
+        let weights = parity::edge_weights(mesh, &vt_count, &vt_first, even);
         let has_quad: Vec<bool> = {
             let mut h = vec![false; nv];
             for q in &mesh.quads {
@@ -109,19 +109,13 @@ impl<'a> State<'a> {
                     dirty: false,
                 };
                 if let Some(w) = &weights {
-                    // Side i of the quad joins its vertices i and i + 1, in one of the pair.
+                    // Side i of the quad joins its vertices i and i + 1: sides 0 and 1 are
+                    // `t1`'s, 2 and 3 `t0`'s (as for `cand_nb` above).
                     let [t0, t1] = table.pairs[c];
                     for i in 0..4 {
+                        let t = if i < 2 { t1 } else { t0 } as usize;
                         let (a, b) = (quad[i], quad[(i + 1) % 4]);
-                        let bit =
-                            parity::weight_of(mesh.triangles[t0 as usize], w[t0 as usize], a, b)
-                                | parity::weight_of(
-                                    mesh.triangles[t1 as usize],
-                                    w[t1 as usize],
-                                    a,
-                                    b,
-                                );
-                        l.par |= bit << i;
+                        l.par |= parity::weight_of(mesh.triangles[t], w[t], a, b) << i;
                     }
                     if even(t0) {
                         l.par |= ACTIVE;

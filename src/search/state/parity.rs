@@ -20,8 +20,14 @@ use crate::mesh::{Mesh, NONE};
 /// argument covers: input quads, a surface boundary or a non-manifold edge inside it (a
 /// triangle side without a neighbour that is no boundary edge), a vertex whose triangles are
 /// not one fan, or a component of genus above 0 (Euler's formula with its boundary loops).
-/// `active(t)`: whether `t` counts (its initial polder is even).
-pub(super) fn edge_weights(mesh: &Mesh, active: impl Fn(u32) -> bool) -> Option<Vec<u8>> {
+/// `active(t)`: whether `t` counts (its initial polder is even); `count[v]` and `first[v]`:
+/// the number of triangles at vertex `v` and one of them.
+pub(super) fn edge_weights(
+    mesh: &Mesh,
+    count: &[u32],
+    first: &[u32],
+    active: impl Fn(u32) -> bool,
+) -> Option<Vec<u8>> {
     let tris = &mesh.triangles;
     let nb = &mesh.topology.neighbours;
     let nt = tris.len();
@@ -32,7 +38,7 @@ pub(super) fn edge_weights(mesh: &Mesh, active: impl Fn(u32) -> bool) -> Option<
     if open != mesh.topology.num_boundary_edges {
         return None;
     }
-    if !fans_are_disks(mesh) || !genus_zero(mesh) {
+    if !fans_are_disks(mesh, count, first) || !genus_zero(mesh, count) {
         return None;
     }
     // A spanning forest of the dual graph, breadth first; the boundary edges and the edges
@@ -100,25 +106,17 @@ pub(super) fn weight_of(tri: [u32; 3], bits: u8, a: u32, b: u32) -> u8 {
 
 /// Every vertex's triangles form one fan (a disk or a half-disk) in the dual graph: a walk
 /// around it from one triangle, both ways where it is open, reaches all of them.
-fn fans_are_disks(mesh: &Mesh) -> bool {
+/// `count[v]`: the triangles at `v`; `first[v]`: one of them.
+fn fans_are_disks(mesh: &Mesh, count: &[u32], first: &[u32]) -> bool {
     let tris = &mesh.triangles;
     let nb = &mesh.topology.neighbours;
-    let nv = mesh.vertices.len();
-    let mut count = vec![0u32; nv];
-    let mut first = vec![NONE; nv];
-    for (t, tri) in tris.iter().enumerate() {
-        for &v in tri {
-            count[v as usize] += 1;
-            first[v as usize] = t as u32;
-        }
-    }
-    // Walks from `start` around `v`, first crossing the edge `v`–`x`, until the fan closes
-    // or opens; the triangles reached (start excluded) and whether it closed.
-    let walk = |v: u32, start: u32, mut x: u32, limit: u32| -> Option<(u32, bool)> {
+    // Walks around `v` from `start`, leaving it across its side `side` (one of the two at
+    // `v`), until the fan closes or opens: the triangles reached (start excluded) and
+    // whether it closed; `None` past `limit`.
+    let walk = |v: u32, start: u32, mut side: usize, limit: u32| -> Option<(u32, bool)> {
         let (mut t, mut seen) = (start, 0u32);
         loop {
-            let i = side_of(tris[t as usize], v, x)? as usize;
-            let u = nb[t as usize][i];
+            let u = nb[t as usize][side];
             if u == NONE {
                 return Some((seen, false));
             }
@@ -129,23 +127,28 @@ fn fans_are_disks(mesh: &Mesh) -> bool {
             if seen > limit {
                 return None;
             }
-            let tri = tris[u as usize];
-            x = *tri.iter().find(|&&y| y != v && y != x)?;
+            // In `u`, the sides at `v` are k and k - 1: leave by the one not towards `t`.
+            let k = tris[u as usize].iter().position(|&x| x == v)?;
+            side = if nb[u as usize][k] != t {
+                k
+            } else {
+                (k + 2) % 3
+            };
             t = u;
         }
     };
-    (0..nv).all(|v| {
+    (0..count.len()).all(|v| {
         let n = count[v];
         if n == 0 {
             return true;
         }
         let (start, v) = (first[v], v as u32);
-        let tri = tris[start as usize];
-        let k = tri.iter().position(|&y| y == v).expect("incident");
-        let (x, z) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
-        match walk(v, start, x, n) {
+        let k = (tris[start as usize].iter())
+            .position(|&y| y == v)
+            .expect("incident");
+        match walk(v, start, k, n) {
             Some((seen, true)) => seen + 1 == n,
-            Some((seen, false)) => match walk(v, start, z, n) {
+            Some((seen, false)) => match walk(v, start, (k + 2) % 3, n) {
                 Some((back, false)) => seen + back + 1 == n,
                 _ => false,
             },
@@ -158,11 +161,10 @@ fn fans_are_disks(mesh: &Mesh) -> bool {
 /// the sum over components (each side is at most the other's per component, so the sums
 /// agree only when every component's do). `L` counts boundary loops, the components of
 /// the boundary edges (one cycle each: the fans are disks).
-fn genus_zero(mesh: &Mesh) -> bool {
+fn genus_zero(mesh: &Mesh, count: &[u32]) -> bool {
     let tris = &mesh.triangles;
     let nb = &mesh.topology.neighbours;
     let nv = mesh.vertices.len();
-    let mut used = vec![false; nv];
     let mut parent: Vec<u32> = (0..nv as u32).collect();
     fn root(parent: &mut [u32], mut v: u32) -> u32 {
         while parent[v as usize] != v {
@@ -175,7 +177,6 @@ fn genus_zero(mesh: &Mesh) -> bool {
     let mut on_boundary = vec![false; nv];
     for (t, tri) in tris.iter().enumerate() {
         for i in 0..3 {
-            used[tri[i] as usize] = true;
             if nb[t][i] == NONE {
                 let (a, b) = (tri[i], tri[(i + 1) % 3]);
                 on_boundary[a as usize] = true;
@@ -190,7 +191,7 @@ fn genus_zero(mesh: &Mesh) -> bool {
     let loops = (0..nv as u32)
         .filter(|&v| on_boundary[v as usize] && root(&mut parent, v) == v)
         .count() as i64;
-    let v = used.iter().filter(|&&u| u).count() as i64;
+    let v = count.iter().filter(|&&n| n > 0).count() as i64;
     let e = mesh.topology.num_edges as i64;
     let f = tris.len() as i64;
     let components = mesh.topology.component_sizes.len() as i64;
@@ -205,8 +206,26 @@ mod tests {
 
     /// Every triangle's sides sum to whether it counts, both triangles of an edge agree on
     /// its weight, and every boundary edge weighs 0: what the parity argument rests on.
+    /// The triangles at each vertex and one of them, as the state's build counts them.
+    fn fans(mesh: &Mesh) -> (Vec<u32>, Vec<u32>) {
+        let mut count = vec![0; mesh.vertices.len()];
+        let mut first = vec![NONE; mesh.vertices.len()];
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for &v in tri {
+                count[v as usize] += 1;
+                first[v as usize] = t as u32;
+            }
+        }
+        (count, first)
+    }
+
+    fn weights(mesh: &Mesh, active: impl Fn(u32) -> bool) -> Option<Vec<u8>> {
+        let (count, first) = fans(mesh);
+        edge_weights(mesh, &count, &first, active)
+    }
+
     fn check_weights(name: &str, mesh: &Mesh, active: impl Fn(u32) -> bool) {
-        let w = edge_weights(mesh, &active).unwrap_or_else(|| panic!("{name}: not covered"));
+        let w = weights(mesh, &active).unwrap_or_else(|| panic!("{name}: not covered"));
         let (tris, nb) = (&mesh.triangles, &mesh.topology.neighbours);
         for t in 0..tris.len() {
             assert_eq!(w[t] & !7, 0, "{name}: triangle {t} has a fourth side");
@@ -282,10 +301,16 @@ mod tests {
 
     #[test]
     fn only_spheres_with_holes_are_covered() {
-        assert!(genus_zero(&wrapped(6, 3, 4)), "a cylinder");
-        assert!(edge_weights(&wrapped(6, 3, 4), |_| true).is_some());
-        assert!(!genus_zero(&wrapped(6, 4, 4)), "a torus");
-        assert!(edge_weights(&wrapped(6, 4, 4), |_| true).is_none());
+        assert!(
+            genus_zero(&wrapped(6, 3, 4), &fans(&wrapped(6, 3, 4)).0),
+            "a cylinder"
+        );
+        assert!(weights(&wrapped(6, 3, 4), |_| true).is_some());
+        assert!(
+            !genus_zero(&wrapped(6, 4, 4), &fans(&wrapped(6, 4, 4)).0),
+            "a torus"
+        );
+        assert!(weights(&wrapped(6, 4, 4), |_| true).is_none());
         // Two fans at one vertex (a bow tie): not a disk around it.
         let bowtie = Mesh::new(MeshData {
             vertices: vec![
@@ -299,8 +324,9 @@ mod tests {
             ..MeshData::default()
         })
         .unwrap();
-        assert!(!fans_are_disks(&bowtie));
-        assert!(edge_weights(&bowtie, |_| true).is_none());
+        let (count, first) = fans(&bowtie);
+        assert!(!fans_are_disks(&bowtie, &count, &first));
+        assert!(weights(&bowtie, |_| true).is_none());
         // Input quads, and a surface boundary inside the mesh: not covered.
         let with_quad = MeshData {
             vertices: vec![
@@ -315,18 +341,18 @@ mod tests {
             ..MeshData::default()
         };
         let triangles_only = Mesh::new(with_quad.clone()).unwrap();
-        assert!(edge_weights(&triangles_only, |_| true).is_some());
+        assert!(weights(&triangles_only, |_| true).is_some());
         let quad = Mesh::new(MeshData {
             quads: vec![[0, 1, 4, 3]],
             ..with_quad
         })
         .unwrap();
-        assert!(edge_weights(&quad, |_| true).is_none());
+        assert!(weights(&quad, |_| true).is_none());
         let surfaces = generate::grid(GridSpec {
             triangles: 200,
             surfaces: 2,
             ..GridSpec::default()
         });
-        assert!(edge_weights(&surfaces, |_| true).is_none());
+        assert!(weights(&surfaces, |_| true).is_none());
     }
 }
