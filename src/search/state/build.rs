@@ -4,7 +4,7 @@
 
 use super::pk::OrderedSets;
 use super::tree::Overlay;
-use super::{CandRecord, ROOT_TAG, State, Verdict, WatchList};
+use super::{CandRecord, ROOT_TAG, State, Verdict, WatchLists};
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 
@@ -130,10 +130,9 @@ impl<'a> State<'a> {
             dead_count: vec![0; nv],
             polder,
             polder_size,
-            watch: (0..nt).map(|_| WatchList::new()).collect(),
+            watch: WatchLists::new(nt, nv),
             dsu_parent: (0..nv as u32).collect(),
             dsu_size: vec![1; nv],
-            root_watch: (0..nv).map(|_| WatchList::new()).collect(),
             arc_roots: [NONE; 4],
             narcs: 0,
             split: Vec::new(),

@@ -2,7 +2,7 @@
 //! every change as an [`Op`], `undo` reverts the last action in O(1) per change, `reset`
 //! returns to the initial state.
 
-use super::{DEAD, Initial, KIND_DISTINCT, KIND_LOCAL, Op, State, WatchList, is_split};
+use super::{DEAD, Initial, KIND_DISTINCT, KIND_LOCAL, Op, State, is_split};
 use crate::mesh::NONE;
 
 /// Capacity of the change log kept across forward-mode actions (ops; 28 bytes each).
@@ -122,8 +122,9 @@ impl State<'_> {
                 if distinct {
                     self.attached.push(child);
                 }
-                for j in 0..self.root_watch[child as usize].len() {
-                    let (c2, ver) = self.root_watch[child as usize][j];
+                let list = self.watch.root(child);
+                for j in 0..self.watch.len(list) {
+                    let (c2, ver) = self.watch.get(list, j);
                     if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
                         self.mark(c2);
                     }
@@ -131,7 +132,7 @@ impl State<'_> {
                 // A root attached stays attached until a reset; without one (no initial
                 // copy), its list is never read again.
                 if self.forward && self.initial.is_none() {
-                    self.root_watch[child as usize] = WatchList::new();
+                    self.watch.free(list);
                 }
             }
         }
@@ -154,9 +155,12 @@ impl State<'_> {
         let local = self.forward && r.kind == KIND_LOCAL;
         self.shrunk.clear();
         for x in [t0, t1] {
-            // Marking touches no watch list: iterate the list taken out, then put it back.
-            let list = std::mem::take(&mut self.watch[x as usize]);
-            for &(c2, ver) in &list {
+            // Nothing pushes onto `x`'s list meanwhile, but `shrink_split` pushes onto
+            // others, which can move the slab: read by index.
+            let n = self.watch.len(x);
+            for j in 0..n {
+                debug_assert_eq!(self.watch.len(x), n);
+                let (c2, ver) = self.watch.get(x, j);
                 if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
                     if (local || distinct) && !self.cand[c2 as usize].dirty {
                         if self.shrunk.contains(&c2) {
@@ -172,8 +176,8 @@ impl State<'_> {
             }
             // Forward mode never reads a used triangle's list again before a reset; without
             // a copy of the initial state there is none, and the list's memory goes back.
-            if !(self.forward && self.initial.is_none()) {
-                self.watch[x as usize] = list;
+            if self.forward && self.initial.is_none() {
+                self.watch.free(x);
             }
         }
         if !self.changed.is_empty() {
@@ -226,16 +230,12 @@ impl State<'_> {
                 | Op::PolderNew
                 | Op::PolderSize { .. }
                 | Op::Union { .. } => unreachable!("handled by undo_shared"),
-                Op::Watch(t) => {
-                    self.watch[t as usize].pop();
-                }
+                Op::Watch(t) => self.watch.pop(t),
                 Op::SplitIns => {
                     let c = self.split.pop().expect("split entry");
                     self.split_pos[c as usize] = NONE;
                 }
-                Op::RootWatch(v) => {
-                    self.root_watch[v as usize].pop();
-                }
+                Op::RootWatch(v) => self.watch.pop(self.watch.root(v)),
                 Op::Dirty => {
                     let c = self.dirty_list.pop().expect("dirty entry");
                     self.cand[c as usize].dirty = false;
@@ -299,8 +299,7 @@ impl State<'_> {
                 dsu_size: self.dsu_size.clone(),
                 split: self.split.clone(),
                 split_pos: self.split_pos.clone(),
-                watch_len: self.watch.iter().map(|w| w.len() as u32).collect(),
-                root_watch_len: self.root_watch.iter().map(|w| w.len() as u32).collect(),
+                watch_len: self.watch.lens().collect(),
                 ver: self.ver,
             }));
         }
@@ -343,11 +342,8 @@ impl State<'_> {
         self.dsu_size.copy_from_slice(&init.dsu_size);
         self.split.clone_from(&init.split);
         self.split_pos.copy_from_slice(&init.split_pos);
-        for (w, &n) in self.watch.iter_mut().zip(&init.watch_len) {
-            w.truncate(n as usize);
-        }
-        for (w, &n) in self.root_watch.iter_mut().zip(&init.root_watch_len) {
-            w.truncate(n as usize);
+        for (i, &n) in init.watch_len.iter().enumerate() {
+            self.watch.truncate(i as u32, n as usize);
         }
         self.ver = init.ver;
         for &c in &self.dirty_list {
