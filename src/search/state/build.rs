@@ -137,6 +137,7 @@ impl<'a> State<'a> {
             narcs: 0,
             split: Vec::new(),
             split_pos: vec![NONE; m],
+            split_compact_at: 0,
             dirty_list: Vec::new(),
             chosen: Vec::new(),
             quality: vec![0.0],

@@ -254,8 +254,13 @@ pub struct State<'a> {
     dsu_size: Vec<u32>,
     arc_roots: [u32; 4],
     narcs: usize,
+    /// The candidates with a split verdict (`split_pos`: their positions, NONE for the
+    /// others), which a polder's change of parity marks; in forward mode used candidates
+    /// are dropped from it now and then ([`State::drop_used_splits`]).
     split: Vec<u32>,
     split_pos: Vec<u32>,
+    /// Forward mode: length of `split` from which the used candidates are dropped.
+    split_compact_at: usize,
     /// Verdicts marked possibly stale and not yet rechecked (their records say `dirty`).
     dirty_list: Vec<u32>,
     chosen: Vec<u32>,

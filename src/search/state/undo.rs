@@ -90,7 +90,12 @@ impl State<'_> {
         self.remaining -= 2;
         self.chosen.push(c);
         let total = self.quality() + self.table.eta[ci];
-        self.quality.push(total);
+        if self.forward && self.quality.len() > 1 {
+            // Nothing is undone: the initial quality (for a reset) and the current one.
+            self.quality[1] = total;
+        } else {
+            self.quality.push(total);
+        }
         for x in [t0, t1] {
             self.set_count(x, 0);
             for c2 in self.table.by_triangle[x as usize] {
@@ -180,6 +185,9 @@ impl State<'_> {
                 self.watch.free(x);
             }
         }
+        if self.forward && self.split.len() >= self.split_compact_at {
+            self.drop_used_splits();
+        }
         if !self.changed.is_empty() {
             for i in 0..self.split.len() {
                 let c2 = self.split[i];
@@ -191,6 +199,28 @@ impl State<'_> {
                 }
             }
         }
+    }
+
+    /// Forward mode: drops the used candidates from the split list (no action reads a used
+    /// candidate's verdict again before a reset, which restores the list): it kept every
+    /// candidate whose verdict was ever a split, 674,000 of the 1.25 million of a
+    /// 10^6-triangle grid by the end of a selective run, 8,000 of them live. Called when the
+    /// list has doubled since the last call, so the copying costs O(1) per entry.
+    fn drop_used_splits(&mut self) {
+        let mut w = 0;
+        for r in 0..self.split.len() {
+            let c = self.split[r];
+            if self.is_live(c) {
+                self.split[w] = c;
+                self.split_pos[c as usize] = w as u32;
+                w += 1;
+            } else {
+                self.split_pos[c as usize] = NONE;
+            }
+        }
+        self.split.truncate(w);
+        self.split_compact_at = (2 * w).max(1024);
+        self.split.shrink_to(self.split_compact_at);
     }
 
     /// Reverts the last `apply`. Panics when nothing was applied.
@@ -376,5 +406,48 @@ impl State<'_> {
             _ => return false,
         }
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::{GridSpec, grid};
+    use crate::quality::CandidateTable;
+
+    /// Forward mode keeps the split list to its live candidates (and their positions
+    /// right) and the quality to two values; a reset brings back the initial ones. (The
+    /// list kept every candidate ever split: 674,000 of a 10^6-triangle grid's run.)
+    #[test]
+    fn forward_runs_keep_the_split_list_to_live_candidates() {
+        let m = grid(GridSpec {
+            triangles: 30_000,
+            holes: true,
+            seed: 3,
+            ..GridSpec::default()
+        });
+        let table = CandidateTable::build(&m);
+        let mut st = State::new(&m, &table);
+        st.set_forward(true);
+        let (split0, quality0) = (st.split.clone(), st.quality.clone());
+        while let Some(k) = st.min_k() {
+            let t = st.bucket_nth(k, 0);
+            let c = (st.candidates_of(t).into_iter())
+                .find(|&c| c != NONE && st.is_allowed(c))
+                .expect("a triangle of P_k has an allowed action");
+            st.apply(c);
+            assert!(
+                st.split.len() < 2 * st.split.iter().filter(|&&c| st.is_live(c)).count() + 1024
+            );
+            for (i, &c) in st.split.iter().enumerate() {
+                assert_eq!(st.split_pos[c as usize], i as u32);
+            }
+            assert_eq!(st.quality.len(), 2);
+        }
+        assert!(st.chosen().len() > 1000, "{} actions", st.chosen().len());
+        let sum: f64 = st.chosen().iter().map(|&c| table.eta[c as usize]).sum();
+        assert_eq!(st.quality(), sum);
+        st.reset();
+        assert_eq!((st.split.clone(), st.quality.clone()), (split0, quality0));
     }
 }
