@@ -23,9 +23,9 @@ pub(super) type Entry = (u32, u32);
 /// A head's length bits; the size class sits above them.
 const LEN_BITS: u32 = 27;
 const LEN_MASK: u32 = (1 << LEN_BITS) - 1;
-/// Size classes: 0 is no block, `k` a block of `2^(k - 1)` entries (the longest list,
-/// `LEN_MASK` entries, fits class 28).
-const CLASSES: usize = 29;
+/// Size classes: 0 is no block, `k` a block of `2^(k - 1)` entries; the largest block,
+/// class 27, holds 2^26 entries (a list's length stays below its bits' limit).
+const CLASSES: usize = 28;
 /// Entries per page (64 KiB: below glibc's mmap threshold, so pages pack in the heap). A
 /// block lies within one page; a larger block gets a page of its size, followed by empty
 /// pages that keep its addresses.
@@ -177,15 +177,15 @@ impl WatchLists {
     fn grow(&mut self, i: u32, first: usize) {
         let h = self.heads[i as usize];
         let (n, k) = (h.len(), h.class());
-        assert!(
-            n < LEN_MASK as usize,
-            "a watch list of {n} entries: over the limit"
-        );
         let new_k = if k == 0 {
             class_for(first.max(1))
         } else {
             (k + 1).max(class_for(4))
         };
+        assert!(
+            new_k < CLASSES,
+            "a watch list of {n} entries: over the limit"
+        );
         let off = self.alloc(new_k);
         if n > 0 {
             let ((pf, f), (pt, t)) = (split(h.off), split(off));
