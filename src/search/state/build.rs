@@ -4,7 +4,7 @@
 
 use super::pk::OrderedSets;
 use super::tree::Overlay;
-use super::{ACTIVE, CandRecord, ROOT_TAG, State, Verdict, WatchList, parity};
+use super::{ACTIVE, CandRecord, ROOT_TAG, State, Verdict, WatchLists, parity};
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 
@@ -148,17 +148,17 @@ impl<'a> State<'a> {
             dead_count: vec![0; nv],
             polder,
             polder_size,
-            watch: (0..nt).map(|_| WatchList::new()).collect(),
+            watch: WatchLists::new(nt, nv),
             dsu_parent: (0..nv as u32).collect(),
             dsu_size: vec![1; nv],
             dsu_par: vec![0; nv],
             odd_active: 0,
             need_parts: false,
-            root_watch: (0..nv).map(|_| WatchList::new()).collect(),
             arc_roots: [NONE; 4],
             narcs: 0,
             split: Vec::new(),
             split_pos: vec![NONE; m],
+            split_compact_at: 0,
             dirty_list: Vec::new(),
             chosen: Vec::new(),
             quality: vec![0.0],

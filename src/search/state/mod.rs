@@ -57,7 +57,9 @@
 //! verdicts and their certificates current (recheck, lazy resolution), `undo` applies and
 //! reverts actions through the change log, `check` evaluates the criterion for one
 //! candidate, `oracle` holds the invariant checker and the from-scratch criterion the
-//! tests compare against, and `acyclic`, `parity`, `pk` and `tree` are described above.
+//! tests compare against, `watch` keeps the watch lists (the verdicts each triangle and
+//! dead-component root certifies) in one slab, and `acyclic`, `parity`, `pk` and `tree`
+//! are described above.
 
 #![allow(clippy::needless_range_loop)] // index loops over the 4 quad sides read best
 
@@ -72,20 +74,16 @@ mod tree;
 mod tree_cache;
 mod undo;
 mod verdicts;
+mod watch;
 
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 pub use audit::{TreeAudit, TreeEvent, TreeView};
 pub use oracle::naive_allowed;
 use pk::OrderedSets;
-use thin_vec::ThinVec;
 pub use tree::Near;
 use tree::Overlay;
-
-/// A watch list: the verdicts `(candidate, version)` whose certificate holds an element.
-/// One pointer (8 bytes; an empty list allocates nothing), where a `Vec` took 24 bytes per
-/// triangle and per vertex, most of them empty or short.
-type WatchList = ThinVec<(u32, u32)>;
+use watch::WatchLists;
 
 /// How a verdict was reached (what it depends on).
 const KIND_LOCAL: u8 = 0;
@@ -230,7 +228,6 @@ struct Initial {
     split: Vec<u32>,
     split_pos: Vec<u32>,
     watch_len: Vec<u32>,
-    root_watch_len: Vec<u32>,
     ver: u32,
 }
 
@@ -263,7 +260,9 @@ pub struct State<'a> {
     dead_count: Vec<u32>,
     polder: Vec<u32>,
     polder_size: Vec<u32>,
-    watch: Vec<WatchList>,
+    /// The watch lists: per triangle, the verdicts whose certificate holds it, and per
+    /// dead-component root (`watch.root(v)`), the verdicts that rely on it staying a root.
+    watch: WatchLists,
     /// Union-find (by size, no path compression, so it can be undone) over vertices: the
     /// connected pieces of the removed region (used triangles, boundaries, input quads).
     dsu_parent: Vec<u32>,
@@ -277,12 +276,15 @@ pub struct State<'a> {
     /// [`State::check`] must search (the parts are relabelled after it), not read a split
     /// off parities.
     need_parts: bool,
-    /// Verdicts that rely on a dead-component root staying a root.
-    root_watch: Vec<WatchList>,
     arc_roots: [u32; 4],
     narcs: usize,
+    /// The candidates with a split verdict (`split_pos`: their positions, NONE for the
+    /// others), which a polder's change of parity marks; in forward mode used candidates
+    /// are dropped from it now and then ([`State::drop_used_splits`]).
     split: Vec<u32>,
     split_pos: Vec<u32>,
+    /// Forward mode: length of `split` from which the used candidates are dropped.
+    split_compact_at: usize,
     /// Verdicts marked possibly stale and not yet rechecked (their records say `dirty`).
     dirty_list: Vec<u32>,
     chosen: Vec<u32>,

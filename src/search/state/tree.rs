@@ -542,7 +542,7 @@ impl State<'_> {
                         .iter()
                         .filter(|&&c2| c2 != NONE),
                 );
-                for &(c2, ver) in &self.watch[x as usize] {
+                for &(c2, ver) in self.watch.slice(x) {
                     if self.cand[c2 as usize].cert_ver == ver {
                         out.push(c2);
                     }
@@ -560,7 +560,7 @@ impl State<'_> {
         }
         for op in &self.log[tr.log_start..] {
             if let Op::Union { child, .. } = *op {
-                for &(c2, ver) in &self.root_watch[child as usize] {
+                for &(c2, ver) in self.watch.slice(self.watch.root(child)) {
                     if self.cand[c2 as usize].cert_ver == ver {
                         out.push(c2);
                     }

@@ -3,7 +3,7 @@
 //! triangle and bucket, stale marks and their lazy resolution.
 
 use super::{
-    CandRecord, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict, WatchList,
+    CandRecord, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict, WatchLists,
     is_split,
 };
 use crate::mesh::NONE;
@@ -358,30 +358,31 @@ impl State<'_> {
         }
     }
 
-    /// Adds `(c, ver)` to the watch list of triangle `t` (logged). In forward mode, where
-    /// nothing is undone, a list that doubled is first cleared of the entries of verdicts
-    /// since recomputed (those past the initial state's, which a reset brings back).
+    /// Adds `(c, ver)` to the watch list of triangle `t` (logged).
     fn watch_push(&mut self, t: u32, c: u32, ver: u32) {
-        if self.forward {
-            let keep = self.initial.as_ref().map_or(0, |i| i.watch_len[t as usize]);
-            prune(&mut self.watch[t as usize], keep as usize, &self.cand);
-        }
-        push_entry(&mut self.watch[t as usize], (c, ver), self.building);
+        self.list_push(t, c, ver);
         self.base_log(Op::Watch(t));
     }
 
-    /// Adds `(c, ver)` to the watch list of dead-component root `v` (logged), pruned as
-    /// [`State::watch_push`] prunes a triangle's.
+    /// Adds `(c, ver)` to the watch list of dead-component root `v` (logged).
     fn root_watch_push(&mut self, v: u32, c: u32, ver: u32) {
+        self.list_push(self.watch.root(v), c, ver);
+        self.base_log(Op::RootWatch(v));
+    }
+
+    /// Adds `(c, ver)` to watch list `i`. In forward mode, where nothing is undone, a list
+    /// that doubled is first cleared of the entries of verdicts since recomputed (those
+    /// past the initial state's, which a reset brings back).
+    #[inline]
+    fn list_push(&mut self, i: u32, c: u32, ver: u32) {
         if self.forward {
             let keep = self
                 .initial
                 .as_ref()
-                .map_or(0, |i| i.root_watch_len[v as usize]);
-            prune(&mut self.root_watch[v as usize], keep as usize, &self.cand);
+                .map_or(0, |init| init.watch_len[i as usize]);
+            prune(&mut self.watch, i, keep as usize, &self.cand);
         }
-        push_entry(&mut self.root_watch[v as usize], (c, ver), self.building);
-        self.base_log(Op::RootWatch(v));
+        self.watch.push(i, (c, ver), first_block(self.building));
     }
 
     /// Moves triangle `t` from `P_old` to `P_new` (logged).
@@ -479,35 +480,23 @@ impl State<'_> {
     }
 }
 
-/// Forward mode: when watch list `list` has doubled (from 4 entries on), drops the entries
+/// Forward mode: when watch list `i` has doubled (from 4 entries on), drops the entries
 /// past `keep` (the initial state's, which a reset brings back) whose verdict was since
 /// recomputed, so that a list holds about twice its live entries at most.
 #[inline]
-fn prune(list: &mut WatchList, keep: usize, cand: &[CandRecord]) {
-    let n = list.len();
+fn prune(lists: &mut WatchLists, i: u32, keep: usize, cand: &[CandRecord]) {
+    let n = lists.len(i);
     if n < 4 || !n.is_power_of_two() {
         return;
     }
-    let mut w = keep;
-    for r in keep..n {
-        let (c2, v2) = list[r];
-        if cand[c2 as usize].cert_ver == v2 {
-            list[w] = (c2, v2);
-            w += 1;
-        }
-    }
-    list.truncate(w);
+    lists.retain_from(i, keep, |(c, ver)| cand[c as usize].cert_ver == ver);
 }
 
-/// Pushes onto a watch list. While the initial verdicts are built (`building`) a list's
-/// first block has room for one entry (`ThinVec` starts at four; most lists of a corridor
-/// hold one or two for the whole run), then it doubles; during a run a list grows to four
-/// at once (each reallocation costs more than the room).
+/// The block a watch list gets at its first entry: while the initial verdicts are built
+/// (`building`) room for one entry (they make most lists, and most lists of a corridor hold
+/// one or two for the whole run), during a run four at once (each move to a larger block
+/// costs more than the room).
 #[inline]
-fn push_entry(list: &mut WatchList, e: (u32, u32), building: bool) {
-    let (len, cap) = (list.len(), list.capacity());
-    if len == cap && cap < 4 {
-        list.reserve_exact(if building && cap == 0 { 1 } else { 4 - len });
-    }
-    list.push(e);
+fn first_block(building: bool) -> usize {
+    if building { 1 } else { 4 }
 }
