@@ -10,6 +10,7 @@ mod budgeted;
 mod lazy;
 mod meshes;
 mod naive;
+mod parity;
 mod selective;
 mod state;
 mod tree;

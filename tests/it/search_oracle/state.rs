@@ -51,7 +51,7 @@ fn check_mesh(
 }
 
 /// [`check_mesh`] with the candidates of `table` (a restricted one: fewer pairs).
-fn check_table(
+pub(super) fn check_table(
     name: &str,
     mesh: &Mesh,
     table: &CandidateTable,

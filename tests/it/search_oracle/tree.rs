@@ -154,7 +154,7 @@ fn tree_walk(name: &str, mesh: &Mesh, seed: u64, max_depth: usize) -> Result<u64
 }
 
 /// [`tree_walk`] with the candidates of `table` (a restricted one: fewer pairs).
-fn tree_walk_on(
+pub(super) fn tree_walk_on(
     name: &str,
     mesh: &Mesh,
     table: &CandidateTable,
