@@ -365,3 +365,138 @@ fn parity_stays_exact_after_forbidden_actions_on_mixed_components() {
     assert!(forbidden > 50, "only {forbidden} forbidden actions applied");
     assert!(parity > 50, "only {parity} splits read off parities");
 }
+
+#[test]
+fn parity_forward_mode_stays_exact_after_forbidden_actions() {
+    // Forward mode never undoes: an odd part of an even polder stays until a reset, which
+    // must bring parities back.
+    let mut meshes = covered();
+    meshes.push(("grid 8x7 holes".into(), grid(8, 7, 0.15, 0.0, 0x52)));
+    let (mut forbidden, mut parity) = (0, 0);
+    for (k, (name, mesh)) in meshes.iter().enumerate() {
+        for (tname, table) in tables(mesh, 0xA0 + k as u64) {
+            let mut state = State::new(mesh, &table);
+            state.set_forward(true);
+            for seed in 0..3 {
+                state.reset();
+                let before = state.parity_splits;
+                let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ 0xC0 ^ seed);
+                let mut oracle = Naive::new(mesh, &table);
+                let at = format!("{name}, {tname}, seed {seed}: after the reset");
+                compare(&mut state, &oracle, &at).unwrap_or_else(|e| panic!("{e}"));
+                loop {
+                    let live: Vec<u32> = (0..table.len() as u32)
+                        .filter(|&c| state.is_live(c))
+                        .collect();
+                    if live.is_empty() {
+                        break;
+                    }
+                    let banned: Vec<u32> = live
+                        .iter()
+                        .copied()
+                        .filter(|&c| !state.is_allowed(c))
+                        .collect();
+                    // Mostly allowed actions (parities stay in use), a forbidden one now
+                    // and then.
+                    let allowed: Vec<u32> = live
+                        .iter()
+                        .copied()
+                        .filter(|&c| !banned.contains(&c))
+                        .collect();
+                    let c = if !banned.is_empty() && (allowed.is_empty() || rng.random_bool(0.1)) {
+                        forbidden += 1;
+                        banned[rng.random_range(0..banned.len())]
+                    } else {
+                        allowed[rng.random_range(0..allowed.len())]
+                    };
+                    state.apply(c);
+                    oracle.apply(c);
+                    let at = format!("{name}, {tname}, forward seed {seed}: apply({c})");
+                    compare(&mut state, &oracle, &at).unwrap_or_else(|e| panic!("{e}"));
+                }
+                parity += state.parity_splits - before;
+            }
+        }
+    }
+    assert!(forbidden > 50, "only {forbidden} forbidden actions applied");
+    assert!(parity > 50, "only {parity} splits read off parities");
+}
+
+#[test]
+fn parity_trees_stay_exact_after_forbidden_pushes() {
+    // The trees push what `tree_push` accepts (both triangles remaining), forbidden actions
+    // too; every tree query is checked at each node, the base after each decision.
+    use super::tree::check_node;
+    let mut meshes = covered();
+    meshes.push(("grid 8x7 holes".into(), grid(8, 7, 0.15, 0.0, 0x53)));
+    let mut forbidden = 0;
+    for (k, (name, mesh)) in meshes.iter().enumerate() {
+        for (tname, table) in tables(mesh, 0xD0 + k as u64) {
+            let mut state = State::new(mesh, &table);
+            let mut oracle = Naive::new(mesh, &table);
+            let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ 0xD7 ^ k as u64);
+            let mut allowed = compare(&mut state, &oracle, "initial")
+                .unwrap()
+                .allowed_actions();
+            let mut step = 0;
+            while !allowed.is_empty() {
+                state.tree_begin();
+                let base_len = oracle.path().len();
+                for e in 0..2 {
+                    let depth_max = rng.random_range(1..=6);
+                    let mut depth = 0;
+                    for op in 0..2 * depth_max {
+                        let live: Vec<u32> = (0..table.len() as u32)
+                            .filter(|&c| {
+                                let [a, b] = table.pairs[c as usize];
+                                oracle.is_remaining(a) && oracle.is_remaining(b)
+                            })
+                            .collect();
+                        let what;
+                        if depth < depth_max && !live.is_empty() && rng.random_bool(0.7) {
+                            let c = live[rng.random_range(0..live.len())];
+                            if !oracle.is_allowed(c) {
+                                forbidden += 1;
+                            }
+                            state.tree_push(c);
+                            oracle.apply(c);
+                            depth += 1;
+                            what = format!("push({c})");
+                        } else if depth > 0 {
+                            state.tree_pop();
+                            oracle.undo();
+                            depth -= 1;
+                            what = "pop()".to_string();
+                        } else {
+                            break;
+                        }
+                        let context = || {
+                            format!(
+                                "{name}, {tname}, decision {step}, exploration {e}, op {op}: after {what}\n  path: {:?}",
+                                oracle.path()
+                            )
+                        };
+                        check_node(
+                            &mut state, &oracle, mesh, &table, &mut rng, base_len, &context,
+                        )
+                        .unwrap_or_else(|e| panic!("{e}"));
+                    }
+                    while depth > 0 {
+                        state.tree_pop();
+                        oracle.undo();
+                        depth -= 1;
+                    }
+                }
+                let c = allowed[rng.random_range(0..allowed.len())];
+                state.apply(c);
+                oracle.apply(c);
+                step += 1;
+                let at = format!("{name}, {tname}, decision {step}: apply({c})");
+                allowed = compare(&mut state, &oracle, &at)
+                    .unwrap_or_else(|e| panic!("{e}"))
+                    .allowed_actions();
+            }
+        }
+    }
+    assert!(forbidden > 50, "only {forbidden} forbidden pushes");
+}

@@ -44,7 +44,7 @@ fn naive_pmin(oracle: &Naive, table: &CandidateTable, nt: u32) -> Option<Vec<u32
 }
 
 /// Checks every tree query at the current node against the oracle.
-fn check_node(
+pub(super) fn check_node(
     state: &mut State<'_>,
     oracle: &Naive,
     mesh: &Mesh,
