@@ -500,3 +500,36 @@ fn parity_trees_stay_exact_after_forbidden_pushes() {
     }
     assert!(forbidden > 50, "only {forbidden} forbidden pushes");
 }
+
+#[test]
+fn parity_matches_oracle_on_random_triangulations() {
+    // Random planar triangulations, some triangles dropped (holes, odd pieces, and pinched
+    // vertices, which turn parities off), next to an icosphere in one mesh.
+    let ico = meshes::icosphere(1);
+    let mut meshes = Vec::new();
+    for s in 0..12u64 {
+        let drop = [0.0, 0.04, 0.1][s as usize % 3];
+        let Some(m) = meshes::random_triangulation(30 + 3 * s as usize, 60, drop, 1, SEED ^ s)
+        else {
+            continue;
+        };
+        let name = format!("random triangulation seed {s}, drop {drop}");
+        if s % 2 == 0 {
+            meshes.push((format!("{name} + icosphere"), union_of(&[&m, &ico], &[])));
+        } else {
+            meshes.push((name, m));
+        }
+    }
+    let parity = walks(&meshes, 1);
+    let (mut forbidden, mut parity_f) = (0, 0);
+    for (k, (name, mesh)) in meshes.iter().enumerate() {
+        for (tname, table) in tables(mesh, 0xE0 + k as u64) {
+            let (f, p) = forbidden_walks(&format!("{name}, {tname}"), mesh, &table, 1);
+            forbidden += f;
+            parity_f += p;
+        }
+    }
+    assert!(parity > 100, "only {parity} splits read off parities");
+    assert!(parity_f > 50, "only {parity_f} splits read off parities");
+    assert!(forbidden > 50, "only {forbidden} forbidden actions applied");
+}
