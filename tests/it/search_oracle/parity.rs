@@ -303,33 +303,48 @@ fn parity_forward_mode_matches_oracle_on_mixed_components() {
     assert!(parity > 50, "only {parity} splits read off parities");
 }
 
+/// The next action of a walk that now and then applies one the criterion forbids: with
+/// probability `p` (or when nothing else is live, with `allowed_only`) a forbidden live
+/// candidate, else any live one (`allowed_only`: an allowed one). `None` when nothing is live;
+/// the flag says the action is forbidden.
+fn pick(
+    state: &State<'_>,
+    table: &CandidateTable,
+    rng: &mut ChaCha8Rng,
+    p: f64,
+    allowed_only: bool,
+) -> Option<(u32, bool)> {
+    let live: Vec<u32> = (0..table.len() as u32)
+        .filter(|&c| state.is_live(c))
+        .collect();
+    let (banned, allowed): (Vec<u32>, Vec<u32>) = live.iter().partition(|&&c| !state.is_allowed(c));
+    let others = if allowed_only { &allowed } else { &live };
+    if others.is_empty() && banned.is_empty() {
+        return None;
+    }
+    if !banned.is_empty() && (others.is_empty() || rng.random_bool(p)) {
+        return Some((banned[rng.random_range(0..banned.len())], true));
+    }
+    Some((others[rng.random_range(0..others.len())], false))
+}
+
 /// Random walks that apply actions the criterion forbids (odd parts of even polders) and
-/// undo some, every answer compared with the oracle after each step.
-fn forbidden_walks(name: &str, mesh: &Mesh, table: &CandidateTable, seeds: u64) -> (u64, u64) {
+/// undo some, every answer compared with the oracle after each step: (forbidden actions
+/// applied, splits read off parities).
+pub(super) fn forbidden_walks(
+    name: &str,
+    mesh: &Mesh,
+    table: &CandidateTable,
+    seeds: u64,
+) -> (u64, u64) {
     let (mut forbidden, mut parity) = (0, 0);
     for seed in 0..seeds {
         let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ 0xB0 ^ seed);
         let mut state = State::new(mesh, table);
         let mut oracle = Naive::new(mesh, table);
         let mut depth = 0;
-        loop {
-            let live: Vec<u32> = (0..table.len() as u32)
-                .filter(|&c| state.is_live(c))
-                .collect();
-            if live.is_empty() {
-                break;
-            }
-            let banned: Vec<u32> = live
-                .iter()
-                .copied()
-                .filter(|&c| !state.is_allowed(c))
-                .collect();
-            let c = if !banned.is_empty() && rng.random_bool(0.3) {
-                forbidden += 1;
-                banned[rng.random_range(0..banned.len())]
-            } else {
-                live[rng.random_range(0..live.len())]
-            };
+        while let Some((c, banned)) = pick(&state, table, &mut rng, 0.3, false) {
+            forbidden += banned as u64;
             state.apply(c);
             oracle.apply(c);
             depth += 1;
@@ -384,31 +399,9 @@ fn parity_forward_mode_stays_exact_after_forbidden_actions() {
                 let mut oracle = Naive::new(mesh, &table);
                 let at = format!("{name}, {tname}, seed {seed}: after the reset");
                 compare(&mut state, &oracle, &at).unwrap_or_else(|e| panic!("{e}"));
-                loop {
-                    let live: Vec<u32> = (0..table.len() as u32)
-                        .filter(|&c| state.is_live(c))
-                        .collect();
-                    if live.is_empty() {
-                        break;
-                    }
-                    let banned: Vec<u32> = live
-                        .iter()
-                        .copied()
-                        .filter(|&c| !state.is_allowed(c))
-                        .collect();
-                    // Mostly allowed actions (parities stay in use), a forbidden one now
-                    // and then.
-                    let allowed: Vec<u32> = live
-                        .iter()
-                        .copied()
-                        .filter(|&c| !banned.contains(&c))
-                        .collect();
-                    let c = if !banned.is_empty() && (allowed.is_empty() || rng.random_bool(0.1)) {
-                        forbidden += 1;
-                        banned[rng.random_range(0..banned.len())]
-                    } else {
-                        allowed[rng.random_range(0..allowed.len())]
-                    };
+                // Mostly allowed actions (parities stay in use), a forbidden one now and then.
+                while let Some((c, banned)) = pick(&state, &table, &mut rng, 0.1, true) {
+                    forbidden += banned as u64;
                     state.apply(c);
                     oracle.apply(c);
                     let at = format!("{name}, {tname}, forward seed {seed}: apply({c})");

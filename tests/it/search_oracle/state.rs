@@ -662,43 +662,7 @@ fn state_stays_exact_after_forbidden_actions() {
         ),
     ] {
         let table = CandidateTable::build(&mesh);
-        for seed in 0..6 {
-            let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ seed);
-            let mut state = State::new(&mesh, &table);
-            let mut depth = 0;
-            loop {
-                let live: Vec<u32> = (0..table.len() as u32)
-                    .filter(|&c| state.is_live(c))
-                    .collect();
-                if live.is_empty() {
-                    break;
-                }
-                let banned: Vec<u32> = live
-                    .iter()
-                    .copied()
-                    .filter(|&c| !state.is_allowed(c))
-                    .collect();
-                let c = if !banned.is_empty() && rng.random_bool(0.3) {
-                    forbidden += 1;
-                    banned[rng.random_range(0..banned.len())]
-                } else {
-                    live[rng.random_range(0..live.len())]
-                };
-                state.apply(c);
-                depth += 1;
-                let at = format!("{name} seed {seed}: action {c} at depth {depth}");
-                state
-                    .sanity_check()
-                    .unwrap_or_else(|e| panic!("{at}, applied: {e}"));
-                if depth > 1 && rng.random_bool(0.25) {
-                    state.undo();
-                    depth -= 1;
-                    state
-                        .sanity_check()
-                        .unwrap_or_else(|e| panic!("{at}, undone: {e}"));
-                }
-            }
-        }
+        forbidden += super::parity::forbidden_walks(name, &mesh, &table, 6).0;
     }
     assert!(forbidden > 20, "only {forbidden} forbidden actions applied");
 }
