@@ -190,6 +190,7 @@ impl<'a> State<'a> {
             searched: 0,
             parity_splits: 0,
             split_shrinks: 0,
+            distinct_kept: 0,
         };
         // The removed region at the start: boundary edges (mesh, surface and quad
         // boundaries: dual sides without a neighbour) and input quads.

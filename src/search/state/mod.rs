@@ -345,6 +345,9 @@ pub struct State<'a> {
     /// Split verdicts kept across an action inside one of their parts instead of a new
     /// search (statistics).
     pub split_shrinks: u64,
+    /// Distinct-components verdicts kept when one of their roots was attached, instead of
+    /// a recheck (statistics).
+    pub distinct_kept: u64,
 }
 
 impl<'a> State<'a> {

@@ -127,10 +127,15 @@ impl State<'_> {
                 if distinct {
                     self.attached.push(child);
                 }
+                // Pushes onto other roots' lists (`keep_distinct`) can move the slab: read
+                // by index.
                 let list = self.watch.root(child);
                 for j in 0..self.watch.len(list) {
                     let (c2, ver) = self.watch.get(list, j);
-                    if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
+                    if self.cand[c2 as usize].cert_ver == ver
+                        && self.is_live(c2)
+                        && !self.keep_distinct(c2, ver)
+                    {
                         self.mark(c2);
                     }
                 }

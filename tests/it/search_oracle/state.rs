@@ -666,3 +666,61 @@ fn state_stays_exact_after_forbidden_actions() {
     }
     assert!(forbidden > 20, "only {forbidden} forbidden actions applied");
 }
+
+#[test]
+fn forward_state_keeps_distinct_verdicts_exact_on_restricted_tables() {
+    // Forward mode keeps a distinct-components verdict when a root it watches is attached
+    // and its arcs' components are still distinct (`keep_distinct`), instead of a recheck.
+    // Dropped pairs make many small dead components that the front then joins: jittered
+    // grids under the valid-quad rule at eta >= 0.5 and random cuts, with and without a copy
+    // of the initial state (a reset copies the initial certificates it rewrites).
+    let mut kept = 0;
+    let mut applies = 0;
+    for i in 0..3u64 {
+        let mut spec = Grid::plain(16, 12);
+        spec.jitter = 0.3;
+        spec.diagonals = Diagonals::Random;
+        spec.holes = 0.03 * i as f64;
+        spec.seed = SEED ^ (0xD1 + i);
+        let mesh = spec.build().unwrap();
+        let full = CandidateTable::build(&mesh);
+        let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ (0xD5 + i));
+        let keep: Vec<bool> = (0..full.len()).map(|_| rng.random_bool(0.8)).collect();
+        let tables = [
+            (
+                "eta >= 0.5",
+                full.clone().restrict(&mesh, Rule::Valid { min_eta: 0.5 }),
+            ),
+            ("80 % of the pairs", full.retain(&keep)),
+        ];
+        for (what, table) in &tables {
+            let name = format!("{spec:?}, {what}");
+            let config = WalkConfig {
+                explorations: 0,
+                max_depth: 1,
+                unwind: false,
+            };
+            let mut state = State::new(&mesh, table);
+            state.set_forward(true);
+            for s in 0..2 {
+                state.reset();
+                let before = state.distinct_kept;
+                let stats = walk(&name, &mesh, table, &mut state, SEED ^ (0xD9 + s), config)
+                    .unwrap_or_else(|e| panic!("{e}"));
+                applies += stats.applies;
+                kept += state.distinct_kept - before;
+            }
+            let mut state = State::new(&mesh, table);
+            state.set_forward_uncopied();
+            let stats = walk(&name, &mesh, table, &mut state, SEED ^ 0xDD, config)
+                .unwrap_or_else(|e| panic!("{e}"));
+            applies += stats.applies;
+            kept += state.distinct_kept;
+        }
+    }
+    eprintln!("forward walks: {applies} actions, {kept} distinct verdicts kept");
+    assert!(
+        kept > 100,
+        "the walks must exercise the kept verdicts: {kept}"
+    );
+}
