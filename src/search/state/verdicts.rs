@@ -3,8 +3,8 @@
 //! triangle and bucket, stale marks and their lazy resolution.
 
 use super::{
-    CandRecord, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict, WatchLists,
-    is_split,
+    CandRecord, Initial, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict,
+    WatchLists, is_split,
 };
 use crate::mesh::NONE;
 
@@ -421,11 +421,7 @@ impl State<'_> {
     #[inline]
     fn list_push(&mut self, i: u32, c: u32, ver: u32) {
         if self.forward {
-            let keep = self
-                .initial
-                .as_ref()
-                .map_or(0, |init| init.watch_len[i as usize]);
-            prune(&mut self.watch, i, keep as usize, &self.cand);
+            prune(&mut self.watch, i, self.initial.as_deref(), &self.cand);
         }
         self.watch.push(i, (c, ver), first_block(self.building));
     }
@@ -528,12 +524,14 @@ impl State<'_> {
 /// Forward mode: when watch list `i` has doubled (from 4 entries on), drops the entries
 /// past `keep` (the initial state's, which a reset brings back) whose verdict was since
 /// recomputed, so that a list holds about twice its live entries at most.
+/// The initial length is read only then (a load from another array per push otherwise).
 #[inline]
-fn prune(lists: &mut WatchLists, i: u32, keep: usize, cand: &[CandRecord]) {
+fn prune(lists: &mut WatchLists, i: u32, initial: Option<&Initial>, cand: &[CandRecord]) {
     let n = lists.len(i);
     if n < 4 || !n.is_power_of_two() {
         return;
     }
+    let keep = initial.map_or(0, |init| init.watch_len[i as usize] as usize);
     lists.retain_from(i, keep, |(c, ver)| cand[c as usize].cert_ver == ver);
 }
 
