@@ -11,6 +11,7 @@ mod lazy;
 mod meshes;
 mod naive;
 mod parity;
+mod parity_multi;
 mod selective;
 mod state;
 mod tree;

@@ -189,6 +189,7 @@ impl<'a> State<'a> {
             searches: 0,
             searched: 0,
             parity_splits: 0,
+            parity_multi: [0; 2],
             split_shrinks: 0,
             distinct_kept: 0,
         };

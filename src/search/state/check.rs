@@ -192,20 +192,20 @@ impl State<'_> {
                 linked = true;
             }
         }
-        // Two groups, separated by the one dead component the quad touches twice (the others
-        // touch it once): on a sphere with holes they are two parts, and the path of dead
-        // edges between the two arcs closes, with the quad's sides between them, into a
-        // curve around one part whose triangles number the parity of its edge weights
-        // ([`super::parity`]). The polder is even (none that was is odd), so the other
-        // part has the same parity, and the verdict is that of a long split certified by
-        // both groups' seeds.
-        let twice = if ns == 2
+        // Groups separated by the one dead component the quad touches `k >= 2` times (the
+        // others touch it once): on a sphere with holes its arcs cut the quad's boundary
+        // into `k` runs, one group each, each in a part of its own; the path of dead edges
+        // between a run's two end arcs closes, with the quad's sides along the run, into a
+        // curve around that part, whose triangles number the parity of its edge weights
+        // ([`super::parity`], [`State::run_parities`]). The polder is even (none that was is
+        // odd), and the verdict is that of a long split certified by every group's seeds.
+        let one = if ns >= 2
             && !self.need_parts
             && self.odd_active == 0
             && self.cand[c as usize].par & ACTIVE != 0
             && !self.cand[c as usize].shared
         {
-            self.arcs_twice()
+            self.arcs_of_one().filter(|&(_, k)| k == ns)
         } else {
             None
         };
@@ -219,12 +219,23 @@ impl State<'_> {
             mask: vmask,
             ..Verdict::default()
         };
-        if let Some((a, b)) = twice {
-            let (i, j) = (arc_at[a], arc_at[b]);
-            let odd = self.find_par(q[i]).1 ^ self.find_par(q[j]).1 ^ self.quad_path(c, i, j);
+        if let Some((d, k)) = one {
+            let odd = self.run_parities(c, &arc_at, &d[..k]);
             let total = self.polder_size[self.polder[t0 as usize] as usize];
             debug_assert_eq!(total % 2, 0, "an active polder is even");
+            debug_assert_eq!(
+                odd[..k].iter().fold(0, |x, &y| x ^ y),
+                0,
+                "the parts of an even polder less a quad have an even total"
+            );
+            debug_assert!(
+                self.runs_are_groups(&arc_at, &d[..k], &live, &root),
+                "each run of neighbours between two arcs is one group"
+            );
             self.parity_splits += 1;
+            if k > 2 {
+                self.parity_multi[k - 3] += 1;
+            }
             self.nsearch = ns;
             for s in 0..ns {
                 self.queue[s].clear();
@@ -240,10 +251,11 @@ impl State<'_> {
                 self.nseed[s] = self.queue[s].len();
                 self.cert_len[s] = self.nseed[s];
             }
+            let odd_parts = odd[..k].iter().map(|&x| x as u32).sum::<u32>();
             return Verdict {
-                fin_odd: 2 * odd,
+                fin_odd: odd_parts as u8,
                 fin_known: total - 2,
-                ..verdict(odd == 0, KIND_SPLIT_LONG)
+                ..verdict(odd_parts == 0, KIND_SPLIT_LONG)
             };
         }
         self.searches += 1;
@@ -367,26 +379,95 @@ impl State<'_> {
         }
     }
 
-    /// The two arcs (indices, in quad order) of the one dead component that touches the
-    /// quad twice, when every other arc's component touches it once.
-    fn arcs_twice(&self) -> Option<(usize, usize)> {
+    /// The arcs (indices, in quad order, and how many) of the one dead component that
+    /// touches the quad more than once, when every other arc's component touches it once.
+    fn arcs_of_one(&self) -> Option<([usize; 4], usize)> {
         let roots = &self.arc_roots[..self.narcs];
-        let mut twice = None;
-        for a in 0..roots.len() {
-            let same = roots.iter().filter(|&&r| r == roots[a]).count();
-            if same > 2 {
-                return None;
-            }
-            if same == 2 {
-                let b = (a + 1..roots.len()).find(|&b| roots[b] == roots[a]);
-                match (twice, b) {
-                    (None, Some(b)) => twice = Some((a, b)),
-                    (Some((x, _)), _) if roots[x] == roots[a] => {}
-                    _ => return None,
+        let mut d = NONE;
+        for &r in roots {
+            if r != d && roots.iter().filter(|&&x| x == r).count() > 1 {
+                if d != NONE {
+                    return None;
                 }
+                d = r;
             }
         }
-        twice
+        if d == NONE {
+            return None;
+        }
+        let (mut arcs, mut k) = ([0usize; 4], 0);
+        for (a, &r) in roots.iter().enumerate() {
+            if r == d {
+                arcs[k] = a;
+                k += 1;
+            }
+        }
+        Some((arcs, k))
+    }
+
+    /// The parity of each part when the quad of `c` touches one dead component at the arcs
+    /// `d` (indices into `arc_at`, the arcs' first quad vertices, in quad order): part `r`
+    /// holds the run of neighbours from arc `d[r]` forwards to arc `d[r + 1]` (cyclically),
+    /// and its parity is the weight of the closed curve made of the dead path between the
+    /// two arcs' first vertices ([`State::find_par`]) and the quad's sides from `d[r]`'s
+    /// forwards to `d[r + 1]`'s: exactly the sides facing that run (and its arcs' own dead
+    /// sides, which are dead edges of the components they belong to). (The other way round
+    /// gives the same sum: the quad's four sides sum to 0, its two triangles counting
+    /// alike.)
+    fn run_parities(&self, c: u32, arc_at: &[usize; 4], d: &[usize]) -> [u8; 4] {
+        let q = &self.table.quads[c as usize];
+        let mut at_par = [0u8; 4];
+        for (r, &a) in d.iter().enumerate() {
+            at_par[r] = self.find_par(q[arc_at[a]]).1;
+        }
+        debug_assert_eq!(self.quad_path(c, 0, 4), 0, "a quad's sides sum to 0");
+        let mut odd = [0u8; 4];
+        for r in 0..d.len() {
+            let r2 = (r + 1) % d.len();
+            let (s, e) = (arc_at[d[r]], arc_at[d[r2]]);
+            let sides = if s < e {
+                self.quad_path(c, s, e)
+            } else {
+                self.quad_path(c, s, 4) ^ self.quad_path(c, 0, e)
+            };
+            odd[r] = at_par[r] ^ at_par[r2] ^ sides;
+        }
+        odd
+    }
+
+    /// Whether the live neighbours between consecutive arcs `d` (of `arc_at`, as for
+    /// [`State::run_parities`]) are one group per run, a different one for each run
+    /// (`root`: the groups' labels per quad side). A debug check.
+    fn runs_are_groups(
+        &self,
+        arc_at: &[usize; 4],
+        d: &[usize],
+        live: &[bool; 4],
+        root: &[u8; 4],
+    ) -> bool {
+        let mut label = [u8::MAX; 4];
+        for r in 0..d.len() {
+            let (s, e) = (arc_at[d[r]], arc_at[d[(r + 1) % d.len()]]);
+            // Sides s, s + 1, ... up to (not including) e, cyclically.
+            let mut i = s;
+            loop {
+                if live[i] {
+                    if label[r] == u8::MAX {
+                        label[r] = root[i];
+                    } else if label[r] != root[i] {
+                        return false;
+                    }
+                }
+                i = (i + 1) % 4;
+                if i == e {
+                    break;
+                }
+            }
+            if label[r] == u8::MAX || label[..r].contains(&label[r]) {
+                return false;
+            }
+        }
+        true
     }
 
     /// Per group (indexed by its root search) of the current searches: triangles visited,

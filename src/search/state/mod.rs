@@ -14,9 +14,9 @@
 //!   connected through the fan. When these links connect every remaining neighbour, the
 //!   removal disconnects nothing and the action is allowed in O(1) (`dead_count[v] == 0`).
 //! * **Parity by the boundary** (`parity`): on a sphere with holes, a quad that touches one
-//!   dead component twice splits its polder in two, and the parity of the part on one side
-//!   is that of edge weights summed along a path of dead edges and the quad's sides, which
-//!   the union–find keeps per vertex: no search.
+//!   dead component `k >= 2` times (every other once) splits its polder into `k` parts, and
+//!   the parity of each is that of edge weights summed along a path of dead edges and the
+//!   quad's sides facing it, which the union–find keeps per vertex: no search.
 //! * **Lockstep search** otherwise: one breadth-first search per group of neighbours, one
 //!   triangle per search per round; groups merge when they meet; it stops when all groups
 //!   met (one part) or all but one finished. Finished groups are whole parts (sizes known),
@@ -342,6 +342,9 @@ pub struct State<'a> {
     pub searched: u64,
     /// Splits decided by parity without a search (statistics).
     pub parity_splits: u64,
+    /// Of those, splits into three parts and into four: one dead component touching the
+    /// quad three or four times (statistics).
+    pub parity_multi: [u64; 2],
     /// Split verdicts kept across an action inside one of their parts instead of a new
     /// search (statistics).
     pub split_shrinks: u64,

@@ -7,9 +7,10 @@
 //! active triangles on either side of it (genus 0: `C` bounds; the weights around each hole
 //! sum to 0). The dead-component union–find keeps, per vertex, the parity of the weights
 //! along a path of dead edges to its root ([`State::find_par`]); a quad that touches one
-//! dead component twice closes such a path into a curve around one of its two parts, whose
-//! parity is then two lookups and the weights of the quad's sides (`check_slow`). See
-//! docs/search.md "Parity by the boundary".
+//! dead component at `k >= 2` arcs closes such a path, between two consecutive arcs, into a
+//! curve around the part on that run of its sides, whose parity is then two lookups and the
+//! weights of the quad's sides (`check_slow`, `run_parities`). See docs/search.md "Parity by
+//! the boundary".
 //!
 //! [`State::find_par`]: super::State::find_par
 
