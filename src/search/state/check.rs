@@ -28,7 +28,7 @@ const LOCAL_OK: [bool; 256] = {
 
 use super::{
     ACTIVE, BLOCKED, DEAD, EPOCH_LIMIT, KIND_DISTINCT, KIND_LOCAL, KIND_MET, KIND_SPLIT,
-    KIND_SPLIT_LONG, LINKED, LONG_PART, Op, ROOT_TAG, State, Verdict,
+    KIND_SPLIT_LONG, LINKED, LONG_PART, Op, READ, ROOT_TAG, State, Verdict,
 };
 use crate::mesh::NONE;
 
@@ -255,6 +255,7 @@ impl State<'_> {
             return Verdict {
                 fin_odd: odd_parts as u8,
                 fin_known: total - 2,
+                mask: vmask | READ,
                 ..verdict(odd_parts == 0, KIND_SPLIT_LONG)
             };
         }

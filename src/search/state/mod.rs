@@ -109,6 +109,14 @@ const LONG_PART: usize = 32;
 /// touch the quad once (see `check_slow`); its certificate ends with the roots of every arc,
 /// tagged with [`ROOT_TAG`], which must stay roots.
 const LINKED: u8 = 1 << 7;
+/// `Verdict::mask` bit: a split read off parities ([`parity`]), certified by its groups'
+/// seeds for the trees (`still_holds`); the base does not watch them. Using a seed cannot
+/// change the verdict unnoticed: the seed's part loses the pair (its parity unchanged) or is
+/// cut, and a cut piece no longer beside the quad changes the polder's parity exactly when
+/// it is odd (the split list marks the verdict); a cut between seeds of one group needs a
+/// link of the group to break (a clean vertex dirtied, marked; a linked arc's root merged,
+/// watched).
+const READ: u8 = 1 << 6;
 /// Tag of a dead-component root in a triangle certificate (vertex and triangle ids stay
 /// below it).
 const ROOT_TAG: u32 = 1 << 31;

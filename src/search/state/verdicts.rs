@@ -3,7 +3,7 @@
 //! triangle and bucket, stale marks and their lazy resolution.
 
 use super::{
-    CandRecord, Initial, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, State, Verdict,
+    CandRecord, Initial, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, READ, State, Verdict,
     WatchLists, is_split,
 };
 use crate::mesh::NONE;
@@ -57,7 +57,10 @@ impl State<'_> {
                 self.root_watch_push(self.arc_roots[i], c, ver);
             }
         } else if r.kind != KIND_LOCAL {
-            for s in 0..self.nsearch {
+            // A split read off parities: its seeds are in the certificate (for the trees)
+            // but not watched ([`READ`]).
+            let seeds = if r.mask & READ != 0 { 0 } else { self.nsearch };
+            for s in 0..seeds {
                 for i in 0..self.cert_len[s] {
                     let t = self.queue[s][i];
                     self.watch_push(t, c, ver);
