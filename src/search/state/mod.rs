@@ -27,7 +27,9 @@
 //!   applying an action rechecks only: the candidates at vertices whose fan just lost its
 //!   first triangle, the verdicts watching the two removed triangles, and, when a polder
 //!   changes parity (only an odd polder can split into parts of other parity), the split
-//!   verdicts in the parts that changed. Proof sketch in `docs/search.md`.
+//!   verdicts in the parts that changed. A distinct-components verdict whose watched root
+//!   merged is kept when its arcs' components are still distinct (forward mode), and a
+//!   split read off parities watches no seed (`READ`). Proof sketch in `docs/search.md`.
 //! * **Linked groups.** A dead component that touches the quad in one arc joins the
 //!   neighbours on either side of it (its frontier runs around it from one to the other), so
 //!   the searches start from fewer groups; such a verdict also watches the arcs' roots.
