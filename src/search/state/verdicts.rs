@@ -197,7 +197,7 @@ impl State<'_> {
     /// arcs themselves (which quad vertices and sides are touched) change only when a
     /// clean vertex of the quad gets a used triangle, which marks it, or when a quad
     /// neighbour between two arcs goes, whose quad joins those arcs' components. On a
-    /// jittered grid under the valid-quad rule, most rechecks were these (a tree of
+    /// jittered grid under the valid-quad rule, two rechecks in five were these (a tree of
     /// dropped pairs joining the front) and found the verdict again.
     pub(super) fn keep_distinct(&mut self, c: u32, ver: u32) -> bool {
         let ci = c as usize;

@@ -7,7 +7,7 @@
 
 use super::meshes::{self, Diagonals, Grid, Wrap};
 use super::naive::Naive;
-use super::state::check_table;
+use super::state::{check_table, forward_walks};
 use super::tree::tree_walk_on;
 use super::walk::{WalkConfig, compare, walk};
 use crate::util::SEED;
@@ -281,23 +281,11 @@ fn parity_forward_mode_matches_oracle_on_mixed_components() {
     for (k, (name, mesh)) in meshes.iter().enumerate() {
         for (tname, table) in tables(mesh, 0x80 + k as u64) {
             let name = format!("{name}, {tname}");
-            let mut state = State::new(mesh, &table);
-            state.set_forward(true);
-            let config = WalkConfig {
-                explorations: 0,
-                max_depth: 1,
-                unwind: false,
-            };
-            for s in 0..3 {
-                state.reset();
-                walk(&name, mesh, &table, &mut state, SEED ^ (0xF0 + s), config)
-                    .unwrap_or_else(|e| panic!("{e}"));
-                parity += state.parity_splits;
-            }
-            let mut state = State::new(mesh, &table);
-            state.set_forward_uncopied();
-            walk(&name, mesh, &table, &mut state, SEED ^ 0xFF, config)
-                .unwrap_or_else(|e| panic!("{e}"));
+            let seeds = [SEED ^ 0xF0, SEED ^ 0xF1, SEED ^ 0xF2];
+            parity += forward_walks(&name, mesh, &table, &seeds, SEED ^ 0xFF, |st| {
+                st.parity_splits
+            })
+            .1;
         }
     }
     assert!(parity > 50, "only {parity} splits read off parities");

@@ -208,6 +208,44 @@ fn state_matches_oracle_deep_explorations() {
     );
 }
 
+/// Forward-mode walks (what `Searcher` runs), every answer compared with the oracle after
+/// every action: one state reset before each of the walks `seeds` (a reset must bring back
+/// the initial verdicts and certificates), then one without a copy of the initial state (a
+/// single run, as `recombine` makes: used triangles' watch lists are dropped and the
+/// initial certificates compacted and rewritten in place) on `uncopied`. Returns the
+/// actions applied and `count` summed over both states at the end.
+pub(super) fn forward_walks(
+    name: &str,
+    mesh: &Mesh,
+    table: &CandidateTable,
+    seeds: &[u64],
+    uncopied: u64,
+    count: impl Fn(&State<'_>) -> u64,
+) -> (u64, u64) {
+    let config = WalkConfig {
+        explorations: 0,
+        max_depth: 1,
+        unwind: false,
+    };
+    let mut applies = 0;
+    let mut state = State::new(mesh, table);
+    state.set_forward(true);
+    for &seed in seeds {
+        state.reset();
+        let stats =
+            walk(name, mesh, table, &mut state, seed, config).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(stats.undos, 0);
+        applies += stats.applies;
+    }
+    let counted = count(&state);
+    let mut state = State::new(mesh, table);
+    state.set_forward_uncopied();
+    let stats =
+        walk(name, mesh, table, &mut state, uncopied, config).unwrap_or_else(|e| panic!("{e}"));
+    assert!(!state.can_reset() || stats.applies == 0);
+    (applies + stats.applies, counted + count(&state))
+}
+
 #[test]
 fn forward_state_matches_oracle() {
     // Forward mode (what `Searcher` runs in): applies only, split verdicts kept without a
@@ -229,39 +267,14 @@ fn forward_state_matches_oracle() {
     let mut applies = 0;
     for (name, mesh) in &meshes {
         let table = CandidateTable::build(mesh);
-        // One state for three walks: reset must bring back the initial verdicts (kept split
-        // verdicts rewrite certificates in place past the initial ones, and copy those).
-        let mut state = State::new(mesh, &table);
-        state.set_forward(true);
-        for s in 0..3 {
-            state.reset();
-            let before = state.split_shrinks;
-            let config = WalkConfig {
-                explorations: 0,
-                max_depth: 1,
-                unwind: false,
-            };
-            let stats = walk(name, mesh, &table, &mut state, SEED ^ (s + 0xF5), config)
-                .unwrap_or_else(|e| panic!("{e}"));
-            assert_eq!(stats.undos, 0);
-            applies += stats.applies;
-            shrinks += state.split_shrinks - before;
-        }
-        // Without a copy of the initial state (a single run, as `recombine` makes): used
-        // triangles' watch lists are dropped, and the initial certificates are compacted and
-        // rewritten in place like the others.
-        let mut state = State::new(mesh, &table);
-        state.set_forward_uncopied();
-        let config = WalkConfig {
-            explorations: 0,
-            max_depth: 1,
-            unwind: false,
-        };
-        let stats = walk(name, mesh, &table, &mut state, SEED ^ 0xF9, config)
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert!(!state.can_reset() || stats.applies == 0);
-        applies += stats.applies;
-        shrinks += state.split_shrinks;
+        // Kept split verdicts rewrite certificates in place past the initial ones, and copy
+        // those.
+        let seeds = [SEED ^ 0xF5, SEED ^ 0xF6, SEED ^ 0xF7];
+        let (a, n) = forward_walks(name, mesh, &table, &seeds, SEED ^ 0xF9, |st| {
+            st.split_shrinks
+        });
+        applies += a;
+        shrinks += n;
     }
     eprintln!("forward walks: {applies} actions, {shrinks} split verdicts kept without a search");
     assert!(
@@ -695,27 +708,12 @@ fn forward_state_keeps_distinct_verdicts_exact_on_restricted_tables() {
         ];
         for (what, table) in &tables {
             let name = format!("{spec:?}, {what}");
-            let config = WalkConfig {
-                explorations: 0,
-                max_depth: 1,
-                unwind: false,
-            };
-            let mut state = State::new(&mesh, table);
-            state.set_forward(true);
-            for s in 0..2 {
-                state.reset();
-                let before = state.distinct_kept;
-                let stats = walk(&name, &mesh, table, &mut state, SEED ^ (0xD9 + s), config)
-                    .unwrap_or_else(|e| panic!("{e}"));
-                applies += stats.applies;
-                kept += state.distinct_kept - before;
-            }
-            let mut state = State::new(&mesh, table);
-            state.set_forward_uncopied();
-            let stats = walk(&name, &mesh, table, &mut state, SEED ^ 0xDD, config)
-                .unwrap_or_else(|e| panic!("{e}"));
-            applies += stats.applies;
-            kept += state.distinct_kept;
+            let seeds = [SEED ^ 0xD9, SEED ^ 0xDA];
+            let (a, n) = forward_walks(&name, &mesh, table, &seeds, SEED ^ 0xDD, |st| {
+                st.distinct_kept
+            });
+            applies += a;
+            kept += n;
         }
     }
     eprintln!("forward walks: {applies} actions, {kept} distinct verdicts kept");
