@@ -102,7 +102,6 @@ impl<'a> State<'a> {
                 let mut l = CandRecord {
                     nb,
                     verdict: Verdict::default(),
-                    cert_ver: 0,
                     flags: 0,
                     shared: false,
                     par: 0,
@@ -135,6 +134,7 @@ impl<'a> State<'a> {
             mesh,
             table,
             closed,
+            cert_ver: vec![0; m],
             cand,
             dual,
             alive: vec![true; nt],
@@ -192,6 +192,7 @@ impl<'a> State<'a> {
             parity_multi: [0; 2],
             split_shrinks: 0,
             distinct_kept: 0,
+            distinct_rekept: 0,
         };
         // The removed region at the start: boundary edges (mesh, surface and quad
         // boundaries: dual sides without a neighbour) and input quads.
@@ -224,8 +225,7 @@ impl<'a> State<'a> {
         st.building = false;
         debug_assert!(st.log.is_empty());
         st.base_cert_init = st.base_cert.len();
-        st.base_cert.shrink_to_fit();
-        st.base_cert_compact_at = st.base_cert_init + m.max(1024);
+        st.set_cert_compact_at(st.base_cert_init + 2 * m);
         st
     }
 }

@@ -45,8 +45,9 @@
 //!   vertices still clean, its certificate intact: checked on reading, nothing is marked),
 //!   else recomputed. `P_min` inside the tree (rare) is the base sets corrected by the
 //!   triangles the path can have changed.
-//! * **Layout.** What is read together is stored together: one 40-byte record per candidate
-//!   (the quad's neighbours, verdict, its version and stale mark); the quad, the pair and
+//! * **Layout.** What is read together is stored together: one 36-byte record per candidate
+//!   (the quad's neighbours, verdict and stale mark), its verdict's version apart in a
+//!   4-byte array (every watch entry read checks it, and most are stale); the quad, the pair and
 //!   each triangle's candidates are read from the table and a triangle's vertices from the
 //!   mesh, not repeated (memory: a 64-byte candidate record with them cost 80 bytes per
 //!   triangle of a grid, a triangle record of its ring of six vertices 24); the lockstep
@@ -131,17 +132,15 @@ fn is_split(kind: u8) -> bool {
     kind == KIND_SPLIT || kind == KIND_SPLIT_LONG
 }
 /// Per candidate: what the local proof reads beside the quad (the table's `quads`), its
-/// verdict, the verdict's version and stale mark, which are read together. 40 bytes: the
-/// quad and the pair are read from the table (they were repeated here, on a 64-byte line).
+/// verdict and stale mark, which are read together. 36 bytes: the quad and the pair are
+/// read from the table (they were repeated here, on a 64-byte line), the verdict's version
+/// from `State::cert_ver`.
 #[derive(Debug, Clone, Copy)]
 struct CandRecord {
     /// The neighbours across the quad's sides (NONE where none).
     nb: [u32; 4],
     /// Its current verdict (base state).
     verdict: Verdict,
-    /// Version of the verdict, which the watch lists refer to (read for every watch entry,
-    /// which then reads the pair).
-    cert_ver: u32,
     /// Bit i: quad vertex i has a closed fan.
     flags: u8,
     /// One triangle neighbours the quad across two of its sides (no local proof then).
@@ -152,7 +151,7 @@ struct CandRecord {
     /// The verdict was marked possibly stale by an action and not yet rechecked.
     dirty: bool,
 }
-const _: () = assert!(std::mem::size_of::<CandRecord>() == 40);
+const _: () = assert!(std::mem::size_of::<CandRecord>() == 36);
 
 /// `CandRecord::par` bit: the candidate's parts can be told apart by parity alone
 /// ([`parity`]).
@@ -251,6 +250,10 @@ pub struct State<'a> {
     closed: Vec<bool>,
     /// Per candidate: its quad's neighbours, verdict, version, stale mark.
     cand: Vec<CandRecord>,
+    /// Per candidate: the version of its verdict, which the watch lists refer to. Apart from
+    /// the records: every watch entry read or pruned reads it, and most entries are stale
+    /// (a 4-byte array stays in cache where 36-byte records do not).
+    cert_ver: Vec<u32>,
     /// The candidates' dual graph as a dense array (the triangle across each side through a
     /// candidate, or NONE), which the lockstep searches stream through.
     dual: Vec<[u32; 3]>,
@@ -361,6 +364,9 @@ pub struct State<'a> {
     /// Distinct-components verdicts kept when one of their roots was attached, instead of
     /// a recheck (statistics).
     pub distinct_kept: u64,
+    /// Distinct-components verdicts found again by a recheck, installed keeping their
+    /// version (`reinstall_distinct`) (statistics).
+    pub distinct_rekept: u64,
 }
 
 impl<'a> State<'a> {

@@ -543,7 +543,7 @@ impl State<'_> {
                         .filter(|&&c2| c2 != NONE),
                 );
                 for &(c2, ver) in self.watch.slice(x) {
-                    if self.cand[c2 as usize].cert_ver == ver {
+                    if self.cert_ver[c2 as usize] == ver {
                         out.push(c2);
                     }
                 }
@@ -561,7 +561,7 @@ impl State<'_> {
         for op in &self.log[tr.log_start..] {
             if let Op::Union { child, .. } = *op {
                 for &(c2, ver) in self.watch.slice(self.watch.root(child)) {
-                    if self.cand[c2 as usize].cert_ver == ver {
+                    if self.cert_ver[c2 as usize] == ver {
                         out.push(c2);
                     }
                 }

@@ -132,7 +132,7 @@ impl State<'_> {
                 let list = self.watch.root(child);
                 for j in 0..self.watch.len(list) {
                     let (c2, ver) = self.watch.get(list, j);
-                    if self.cand[c2 as usize].cert_ver == ver
+                    if self.cert_ver[c2 as usize] == ver
                         && self.is_live(c2)
                         && !self.keep_distinct(c2, ver)
                     {
@@ -171,7 +171,7 @@ impl State<'_> {
             for j in 0..n {
                 debug_assert_eq!(self.watch.len(x), n);
                 let (c2, ver) = self.watch.get(x, j);
-                if self.cand[c2 as usize].cert_ver == ver && self.is_live(c2) {
+                if self.cert_ver[c2 as usize] == ver && self.is_live(c2) {
                     if (local || distinct) && !self.cand[c2 as usize].dirty {
                         if self.shrunk.contains(&c2) {
                             continue;
@@ -254,7 +254,7 @@ impl State<'_> {
                 }
                 Op::Verdict { c, old, ver } => {
                     self.cand[c as usize].verdict = old;
-                    self.cand[c as usize].cert_ver = ver;
+                    self.cert_ver[c as usize] = ver;
                 }
                 Op::Count { t, old } => {
                     let cur = self.count[t as usize];
@@ -326,7 +326,7 @@ impl State<'_> {
         if on && self.initial.is_none() {
             self.initial = Some(Box::new(Initial {
                 verdict: self.cand.iter().map(|l| l.verdict).collect(),
-                cert_ver: self.cand.iter().map(|l| l.cert_ver).collect(),
+                cert_ver: self.cert_ver.clone(),
                 count: self.count.clone(),
                 sets: self.sets.clone(),
                 polder: self.polder.clone(),
@@ -367,10 +367,10 @@ impl State<'_> {
             .initial
             .as_ref()
             .expect("forward mode keeps the initial state");
-        for (c, (v, &ver)) in init.verdict.iter().zip(&init.cert_ver).enumerate() {
+        for (c, v) in init.verdict.iter().enumerate() {
             self.cand[c].verdict = *v;
-            self.cand[c].cert_ver = ver;
         }
+        self.cert_ver.copy_from_slice(&init.cert_ver);
         self.count.copy_from_slice(&init.count);
         self.sets.clone_from(&init.sets);
         self.polder.copy_from_slice(&init.polder);

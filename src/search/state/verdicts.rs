@@ -3,8 +3,8 @@
 //! triangle and bucket, stale marks and their lazy resolution.
 
 use super::{
-    CandRecord, Initial, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, READ, State, Verdict,
-    WatchLists, is_split,
+    Initial, KIND_DISTINCT, KIND_LOCAL, KIND_SPLIT, LINKED, Op, READ, State, Verdict, WatchLists,
+    is_split,
 };
 use crate::mesh::NONE;
 
@@ -35,14 +35,18 @@ impl State<'_> {
         if r.kind == KIND_LOCAL && old.kind == KIND_LOCAL && r.allowed == old.allowed {
             return;
         }
+        if self.forward && r.kind == KIND_DISTINCT && old.kind == KIND_DISTINCT {
+            self.reinstall_distinct(c, r);
+            return;
+        }
         self.base_log(Op::Verdict {
             c,
             old,
-            ver: self.cand[ci].cert_ver,
+            ver: self.cert_ver[ci],
         });
         self.ver = self.ver.wrapping_add(1);
         let ver = self.ver;
-        self.cand[ci].cert_ver = ver;
+        self.cert_ver[ci] = ver;
         (r.cert, r.cert_len) = self.append_cert(r.kind, false);
         self.cand[ci].verdict = r;
         if r.allowed != old.allowed {
@@ -171,7 +175,7 @@ impl State<'_> {
                     self.base_cert.push(t);
                 }
             }
-            let ver = self.cand[ci].cert_ver;
+            let ver = self.cert_ver[ci];
             for i in 0..self.fan.len() {
                 let t = self.fan[i];
                 self.base_cert.push(t);
@@ -232,6 +236,40 @@ impl State<'_> {
         }
         self.distinct_kept += 1;
         true
+    }
+
+    /// Forward mode: installs distinct-components verdict `r` of `c` (the last check's, its
+    /// roots in `arc_roots`) over a distinct-components verdict, keeping its version, so
+    /// that only the roots the old certificate did not hold are newly watched (a recheck
+    /// for a dirtied vertex mostly finds the same components). An entry left on a root
+    /// the new certificate no longer holds reads as current: when that root is attached,
+    /// `keep_distinct` rereads the certificate (or the candidate is marked), a check more
+    /// and never one less, as every reader of a watch list only marks or rereads. Both
+    /// verdicts are allowed: a dead component's arcs in distinct components cut nothing.
+    fn reinstall_distinct(&mut self, c: u32, mut r: Verdict) {
+        let ci = c as usize;
+        let old = self.cand[ci].verdict;
+        debug_assert!(old.allowed && r.allowed && self.forward);
+        let (off, len) = (old.cert as usize, old.cert_len as usize);
+        let mut before = [NONE; 4];
+        before[..len].copy_from_slice(&self.base_cert[off..off + len]);
+        let n = self.narcs;
+        if n == len && off >= self.cert_floor() {
+            // Its own certificate, past the initial ones: rewritten in place.
+            self.base_cert[off..off + n].copy_from_slice(&self.arc_roots[..n]);
+            (r.cert, r.cert_len) = (old.cert, old.cert_len);
+        } else {
+            (r.cert, r.cert_len) = self.append_cert(KIND_DISTINCT, false);
+        }
+        self.cand[ci].verdict = r;
+        let ver = self.cert_ver[ci];
+        for i in 0..n {
+            let root = self.arc_roots[i];
+            if !before[..len].contains(&root) {
+                self.root_watch_push(root, c, ver);
+            }
+        }
+        self.distinct_rekept += 1;
     }
 
     /// Whether the quad of `c` touches at most one of the dead components in `y_roots`
@@ -365,11 +403,24 @@ impl State<'_> {
             end += len;
         }
         self.base_cert.truncate(end);
-        self.base_cert_compact_at = init + (2 * (end - init)).max(self.cand.len()).max(1024);
-        // Give back what the arena grew past the next compaction (plus room for one
-        // action's appends): its capacity only ever grew, by doubling.
+        self.set_cert_compact_at(init + (2 * (end - init)).max(2 * self.cand.len()));
+    }
+
+    /// Sets the arena length at which it is next compacted (at least the candidate count
+    /// twice past what it keeps: the scan reads every candidate's record, 5 MB on a
+    /// 10^5-triangle grid, and each halving of the compactions cost about 5 bytes per
+    /// triangle) and gives the arena that capacity, plus room for one action's appends.
+    /// Growing to it by doubling instead would overshoot by up to its size: 16 bytes per
+    /// triangle more at the peak of selective on a 10^6-triangle grid.
+    pub(super) fn set_cert_compact_at(&mut self, at: usize) {
+        self.base_cert_compact_at = at.max(1024);
         let room = self.base_cert_compact_at + self.base_cert_compact_at / 8;
-        self.base_cert.shrink_to(room);
+        let len = self.base_cert.len();
+        if self.base_cert.capacity() > room {
+            self.base_cert.shrink_to(room);
+        } else {
+            self.base_cert.reserve_exact(room - len);
+        }
     }
 
     /// Length of the arena's prefix that stays as it is: the initial verdicts'
@@ -424,7 +475,7 @@ impl State<'_> {
     #[inline]
     fn list_push(&mut self, i: u32, c: u32, ver: u32) {
         if self.forward {
-            prune(&mut self.watch, i, self.initial.as_deref(), &self.cand);
+            prune(&mut self.watch, i, self.initial.as_deref(), &self.cert_ver);
         }
         self.watch.push(i, (c, ver), first_block(self.building));
     }
@@ -456,7 +507,7 @@ impl State<'_> {
         self.base_log(Op::Verdict {
             c,
             old: self.cand[ci].verdict,
-            ver: self.cand[ci].cert_ver,
+            ver: self.cert_ver[ci],
         });
         self.cand[ci].verdict.allowed = false;
     }
@@ -529,13 +580,13 @@ impl State<'_> {
 /// recomputed, so that a list holds about twice its live entries at most.
 /// The initial length is read only then (a load from another array per push otherwise).
 #[inline]
-fn prune(lists: &mut WatchLists, i: u32, initial: Option<&Initial>, cand: &[CandRecord]) {
+fn prune(lists: &mut WatchLists, i: u32, initial: Option<&Initial>, cert_ver: &[u32]) {
     let n = lists.len(i);
     if n < 4 || !n.is_power_of_two() {
         return;
     }
     let keep = initial.map_or(0, |init| init.watch_len[i as usize] as usize);
-    lists.retain_from(i, keep, |(c, ver)| cand[c as usize].cert_ver == ver);
+    lists.retain_from(i, keep, |(c, ver)| cert_ver[c as usize] == ver);
 }
 
 /// The block a watch list gets at its first entry: while the initial verdicts are built

@@ -686,9 +686,12 @@ fn forward_state_keeps_distinct_verdicts_exact_on_restricted_tables() {
     // and its arcs' components are still distinct (`keep_distinct`), instead of a recheck.
     // Dropped pairs make many small dead components that the front then joins: jittered
     // grids under the valid-quad rule at eta >= 0.5 and random cuts, with and without a copy
-    // of the initial state (a reset copies the initial certificates it rewrites).
+    // of the initial state (a reset copies the initial certificates it rewrites). A recheck
+    // that finds a distinct-components verdict again keeps its version and watches only
+    // the new roots (`reinstall_distinct`): the walks count those too.
     let mut kept = 0;
     let mut applies = 0;
+    let rekept = std::cell::Cell::new(0);
     for i in 0..3u64 {
         let mut spec = Grid::plain(16, 12);
         spec.jitter = 0.3;
@@ -710,15 +713,19 @@ fn forward_state_keeps_distinct_verdicts_exact_on_restricted_tables() {
             let name = format!("{spec:?}, {what}");
             let seeds = [SEED ^ 0xD9, SEED ^ 0xDA];
             let (a, n) = forward_walks(&name, &mesh, table, &seeds, SEED ^ 0xDD, |st| {
+                rekept.set(rekept.get() + st.distinct_rekept);
                 st.distinct_kept
             });
             applies += a;
             kept += n;
         }
     }
-    eprintln!("forward walks: {applies} actions, {kept} distinct verdicts kept");
+    let rekept = rekept.get();
+    eprintln!(
+        "forward walks: {applies} actions, {kept} distinct verdicts kept, {rekept} found again"
+    );
     assert!(
-        kept > 100,
-        "the walks must exercise the kept verdicts: {kept}"
+        kept > 100 && rekept > 100,
+        "the walks must exercise the kept verdicts: {kept} kept, {rekept} found again"
     );
 }
