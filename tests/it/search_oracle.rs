@@ -7,6 +7,7 @@
 
 mod audit;
 mod budgeted;
+mod forward_lazy;
 mod lazy;
 mod meshes;
 mod naive;

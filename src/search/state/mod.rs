@@ -248,7 +248,7 @@ pub struct State<'a> {
     // ---- static ----
     /// Vertex fan is one closed cycle of triangles in the dual graph.
     closed: Vec<bool>,
-    /// Per candidate: its quad's neighbours, verdict, version, stale mark.
+    /// Per candidate: its quad's neighbours, verdict, stale mark.
     cand: Vec<CandRecord>,
     /// Per candidate: the version of its verdict, which the watch lists refer to. Apart from
     /// the records: every watch entry read or pruned reads it, and most entries are stale

@@ -241,10 +241,12 @@ impl State<'_> {
     /// Forward mode: installs distinct-components verdict `r` of `c` (the last check's, its
     /// roots in `arc_roots`) over a distinct-components verdict, keeping its version, so
     /// that only the roots the old certificate did not hold are newly watched (a recheck
-    /// for a dirtied vertex mostly finds the same components). An entry left on a root
-    /// the new certificate no longer holds reads as current: when that root is attached,
-    /// `keep_distinct` rereads the certificate (or the candidate is marked), a check more
-    /// and never one less, as every reader of a watch list only marks or rereads. Both
+    /// for a dirtied vertex mostly finds the same components). An entry can stay on a root
+    /// the new certificate no longer holds only if that root was already attached (an arc
+    /// only grows, and two arcs share a root only once their components merged): forward
+    /// mode never reads such a list again, and were it read, `keep_distinct` works from the
+    /// certificate's own roots and the other readers only mark, a check more and never one
+    /// less. A root in both certificates keeps its entry, made under this version. Both
     /// verdicts are allowed: a dead component's arcs in distinct components cut nothing.
     fn reinstall_distinct(&mut self, c: u32, mut r: Verdict) {
         let ci = c as usize;
@@ -368,7 +370,7 @@ impl State<'_> {
     /// candidates refer to (past the initial verdicts', which a reset brings back). Runs
     /// append a certificate per recomputed verdict; without this the arena grew with every
     /// recheck of a run (1.6 GB for greedy on a 10^6-triangle grid). Called when the arena
-    /// has grown by the candidate count and twice what was kept, so the copying costs O(1)
+    /// has grown by twice the candidate count and twice what was kept, so the copying costs O(1)
     /// per appended entry. In place: the certificates kept move down in arena order (each
     /// verdict's certificate is its own, so none is overwritten before it moved).
     pub(super) fn compact_base_cert(&mut self) {
