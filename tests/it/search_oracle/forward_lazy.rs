@@ -54,14 +54,7 @@ fn walk(
             }
         }
         let t = rng.random_range(0..nt);
-        let exp = if oracle.is_remaining(t) {
-            table.by_triangle[t as usize]
-                .iter()
-                .filter(|&&d| d != NONE && oracle.is_allowed(d))
-                .count() as u32
-        } else {
-            0
-        };
+        let exp = oracle.allowed_count(table, t);
         let got = state.allowed_count_lazy(t);
         if got != exp {
             return Err(ctx(&format!(

@@ -91,14 +91,7 @@ fn lazy_walk(name: &str, mesh: &Mesh, seed: u64, max_depth: usize) -> Result<u64
                     }
                 }
                 for t in tris {
-                    let expected = if oracle.is_remaining(t) {
-                        table.by_triangle[t as usize]
-                            .iter()
-                            .filter(|&&d| d != NONE && oracle.is_allowed(d))
-                            .count() as u32
-                    } else {
-                        0
-                    };
+                    let expected = oracle.allowed_count(&table, t);
                     let got = state.allowed_count_lazy(t);
                     queries += 1;
                     if got != expected {

@@ -190,6 +190,18 @@ impl Naive {
         }
     }
 
+    /// Allowed candidates of triangle `t` (0 once it is used), what the state's
+    /// `allowed_count` gives.
+    pub fn allowed_count(&self, table: &CandidateTable, t: u32) -> u32 {
+        if !self.is_remaining(t) {
+            return 0;
+        }
+        table.by_triangle[t as usize]
+            .iter()
+            .filter(|&&d| d != NONE && self.is_allowed(d))
+            .count() as u32
+    }
+
     /// Number of odd components of the dual graph of all remaining triangles.
     pub fn odd_polders(&self) -> usize {
         let scratch = &mut *self.scratch.borrow_mut();
