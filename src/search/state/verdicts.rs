@@ -219,23 +219,40 @@ impl State<'_> {
             }
             roots[k] = r;
         }
-        // The initial verdicts' certificates stay as they are for a reset: a copy.
-        let off = if off < self.cert_floor() {
-            let new = self.base_cert.len();
-            self.base_cert.extend_from_within(off..off + len);
-            self.cand[ci].verdict.cert = new as u32;
-            new
-        } else {
-            off
-        };
-        for k in 0..len {
-            if self.base_cert[off + k] != roots[k] {
-                self.base_cert[off + k] = roots[k];
-                self.root_watch_push(roots[k], c, ver);
-            }
-        }
+        debug_assert_eq!(ver, self.cert_ver[ci]);
+        self.set_distinct_cert(c, roots, len);
         self.distinct_kept += 1;
         true
+    }
+
+    /// Forward mode: makes the first `n` of `roots` the certificate of the
+    /// distinct-components verdict of `c`, keeping its version: in place when its current
+    /// certificate is its own (past [`State::cert_floor`]) and as long, else appended (an
+    /// initial verdict's stays as it is for a reset). Only the roots the current certificate
+    /// does not hold are newly watched; the others keep their entries, made under this
+    /// version.
+    fn set_distinct_cert(&mut self, c: u32, roots: [u32; 4], n: usize) {
+        let ci = c as usize;
+        let v = self.cand[ci].verdict;
+        let (off, len) = (v.cert as usize, v.cert_len as usize);
+        let mut before = [NONE; 4];
+        before[..len].copy_from_slice(&self.base_cert[off..off + len]);
+        let off = if n == len && off >= self.cert_floor() {
+            off
+        } else {
+            let new = self.base_cert.len();
+            self.base_cert.resize(new + n, NONE);
+            new
+        };
+        self.base_cert[off..off + n].copy_from_slice(&roots[..n]);
+        let v = &mut self.cand[ci].verdict;
+        (v.cert, v.cert_len) = (off as u32, n as u32);
+        let ver = self.cert_ver[ci];
+        for &r in &roots[..n] {
+            if !before[..len].contains(&r) {
+                self.root_watch_push(r, c, ver);
+            }
+        }
     }
 
     /// Forward mode: installs distinct-components verdict `r` of `c` (the last check's, its
@@ -248,29 +265,19 @@ impl State<'_> {
     /// certificate's own roots and the other readers only mark, a check more and never one
     /// less. A root in both certificates keeps its entry, made under this version. Both
     /// verdicts are allowed: a dead component's arcs in distinct components cut nothing.
-    fn reinstall_distinct(&mut self, c: u32, mut r: Verdict) {
+    fn reinstall_distinct(&mut self, c: u32, r: Verdict) {
         let ci = c as usize;
         let old = self.cand[ci].verdict;
         debug_assert!(old.allowed && r.allowed && self.forward);
-        let (off, len) = (old.cert as usize, old.cert_len as usize);
-        let mut before = [NONE; 4];
-        before[..len].copy_from_slice(&self.base_cert[off..off + len]);
+        self.cand[ci].verdict = Verdict {
+            cert: old.cert,
+            cert_len: old.cert_len,
+            ..r
+        };
         let n = self.narcs;
-        if n == len && off >= self.cert_floor() {
-            // Its own certificate, past the initial ones: rewritten in place.
-            self.base_cert[off..off + n].copy_from_slice(&self.arc_roots[..n]);
-            (r.cert, r.cert_len) = (old.cert, old.cert_len);
-        } else {
-            (r.cert, r.cert_len) = self.append_cert(KIND_DISTINCT, false);
-        }
-        self.cand[ci].verdict = r;
-        let ver = self.cert_ver[ci];
-        for i in 0..n {
-            let root = self.arc_roots[i];
-            if !before[..len].contains(&root) {
-                self.root_watch_push(root, c, ver);
-            }
-        }
+        let mut roots = [NONE; 4];
+        roots[..n].copy_from_slice(&self.arc_roots[..n]);
+        self.set_distinct_cert(c, roots, n);
         self.distinct_rekept += 1;
     }
 
@@ -410,8 +417,8 @@ impl State<'_> {
 
     /// Sets the arena length at which it is next compacted (at least the candidate count
     /// twice past what it keeps: the scan reads every candidate's record, 5 MB on a
-    /// 10^5-triangle grid, and each halving of the compactions cost about 5 bytes per
-    /// triangle) and gives the arena that capacity, plus room for one action's appends.
+    /// 10^5-triangle grid; halving the compactions cost 6–7 bytes per triangle at the peaks
+    /// of `bench rss` at 10^6) and gives the arena that capacity, plus room for one action's appends.
     /// Growing to it by doubling instead would overshoot by up to its size: 16 bytes per
     /// triangle more at the peak of selective on a 10^6-triangle grid.
     pub(super) fn set_cert_compact_at(&mut self, at: usize) {
