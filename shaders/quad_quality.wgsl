@@ -94,8 +94,12 @@ fn quad_eta(s0: Vertex, o1: Vertex, s1: Vertex, o0: Vertex) -> f32 {
 }
 
 /// eta from the edge vectors a = s1 - s0, e0 = o0 - s0, e1 = o1 - s0, f0 = o0 - s1,
-/// f1 = o1 - s1 (each at any positive scale).
+/// f1 = o1 - s1 (each at any positive scale). 0 for a pair folded over its diagonal (the
+/// triangles' normals 90 degrees apart or more), as `quality::quad_eta`.
 fn eta_from_edges(a: vec3<f32>, e0: vec3<f32>, e1: vec3<f32>, f0: vec3<f32>, f1: vec3<f32>) -> f32 {
+    if dot(cross(a, e0), cross(-a, f1)) <= 0.0 {
+        return 0.0;
+    }
     let alpha = vec4<f32>(
         angle(a, e0) + angle(e1, a),
         angle(e1, f1),

@@ -54,14 +54,66 @@ pub fn eta_from_angles(alpha: [f64; 4]) -> f64 {
 /// eta of the quad `[s0, o1, s1, o0]` made of triangles `(s0, s1, o0)` and `(s1, s0, o1)`
 /// sharing the diagonal `s0`–`s1`. At the diagonal's endpoints the angle is the *sum* of the
 /// two triangles' angles there (3D angles, so surface meshes work); at the opposite vertices it
-/// is the triangle's own angle.
+/// is the triangle's own angle. A pair folded over its diagonal (`o1` on `o0`'s side in the
+/// plane; on a surface, the triangles' normals 90 degrees apart or more, where Gmsh's minSICN
+/// of the quad turns negative) makes no quad: its eta is 0, although the sums of unsigned
+/// angles would read as those of the unfolded quad. On a planar pair that is not folded, eta
+/// > 0 is exactly strict convexity.
 pub fn quad_eta(p: [[f64; 3]; 4]) -> f64 {
     let [s0, o1, s1, o0] = p;
     let a0 = angle(s0, s1, o0) + angle(s0, o1, s1);
     let a1 = angle(o1, s0, s1);
     let a2 = angle(s1, o0, s0) + angle(s1, s0, o1);
     let a3 = angle(o0, s1, s0);
-    eta_from_angles([a0, a1, a2, a3])
+    let eta = eta_from_angles([a0, a1, a2, a3]);
+    if eta > 0.0 && folded(p) {
+        return 0.0;
+    }
+    eta
+}
+
+/// Whether the two triangles of the quad `[s0, o1, s1, o0]` (as for [`quad_eta`]) are bent
+/// over their diagonal by a right angle or more: their normals, in the orientation they share
+/// in the mesh, make an angle of 90 degrees or more (they point away from each other).
+fn folded(p: [[f64; 3]; 4]) -> bool {
+    use crate::mesh::topology::{cross, dot, sub};
+    let [s0, o1, s1, o0] = p;
+    let n0 = cross(unit_range(sub(s1, s0)), unit_range(sub(o0, s0)));
+    let n1 = cross(unit_range(sub(s0, s1)), unit_range(sub(o1, s1)));
+    dot(unit_range(n0), unit_range(n1)) <= 0.0
+}
+
+/// Whether every corner of the quad `p` (a cycle of four points) turns the same way about
+/// the quad's vector area (Newell's normal): true for a strictly convex quad, planar or
+/// gently curved; false for a reflex corner, a self-intersecting "bowtie" or a pair of
+/// triangles folded onto each other.
+pub fn turns_one_way(p: [[f64; 3]; 4]) -> bool {
+    turning(p).is_some()
+}
+
+/// The quad `p` relative to its centroid and scaled to unit size (so that neither the
+/// products nor the test depend on the coordinates' magnitude) when its corners all turn
+/// one way ([`turns_one_way`]), else `None`.
+fn turning(p: [[f64; 3]; 4]) -> Option<[[f64; 3]; 4]> {
+    use crate::mesh::topology::{cross, dot, sub};
+    let c = [0, 1, 2].map(|k| p.iter().map(|v| v[k]).sum::<f64>() / 4.0);
+    let rel = p.map(|v| sub(v, c));
+    let m = rel.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    if m == 0.0 || !m.is_finite() {
+        return None;
+    }
+    let q = rel.map(|v| v.map(|x| x / m));
+    let mut normal = [0.0; 3];
+    for k in 0..4 {
+        let x = cross(q[k], q[(k + 1) % 4]);
+        normal = [normal[0] + x[0], normal[1] + x[1], normal[2] + x[2]];
+    }
+    (0..4)
+        .all(|k| {
+            let (prev, here, next) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
+            dot(cross(sub(here, prev), sub(next, here)), normal) > 0.0
+        })
+        .then_some(q)
 }
 
 /// eta of a quad given as a cycle of four corners, as a mesh file holds it: eq. 1 on its four
@@ -70,31 +122,12 @@ pub fn quad_eta(p: [[f64; 3]; 4]) -> f64 {
 /// or one lobe of a self-intersecting "bowtie") has an interior angle above pi: eta 0. The
 /// orientation is the quad's vector area (Newell's normal), so curved-surface quads work.
 /// Recombined candidates are read across their diagonal instead ([`quad_eta`]): on a planar
-/// quad both give the same value.
+/// quad both give the same value (both 0 for a pair folded over its diagonal).
 pub fn input_quad_eta(p: [[f64; 3]; 4]) -> f64 {
-    use crate::mesh::topology::{cross, dot, sub};
-    // Relative to the centroid, scaled to unit size, so that neither the products below nor
-    // the tolerance depend on the coordinates' magnitude.
-    let c = [0, 1, 2].map(|k| p.iter().map(|v| v[k]).sum::<f64>() / 4.0);
-    let rel = p.map(|v| sub(v, c));
-    let m = rel.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-    if m == 0.0 || !m.is_finite() {
+    let Some(q) = turning(p) else {
         return 0.0;
-    }
-    let q = rel.map(|v| v.map(|x| x / m));
-    let mut normal = [0.0; 3];
-    for k in 0..4 {
-        let x = cross(q[k], q[(k + 1) % 4]);
-        normal = [normal[0] + x[0], normal[1] + x[1], normal[2] + x[2]];
-    }
-    let mut alpha = [0.0; 4];
-    for k in 0..4 {
-        let (prev, here, next) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
-        if dot(cross(sub(here, prev), sub(next, here)), normal) <= 0.0 {
-            return 0.0;
-        }
-        alpha[k] = angle(here, prev, next);
-    }
+    };
+    let alpha: [f64; 4] = std::array::from_fn(|k| angle(q[k], q[(k + 3) % 4], q[(k + 1) % 4]));
     eta_from_angles(alpha)
 }
 
@@ -427,6 +460,36 @@ pub fn recombined(mesh: &Mesh, table: &CandidateTable, chosen: &[u32]) -> Recomb
 mod tests {
     use super::*;
 
+    /// Rotates `p` about the x axis by `theta` (radians).
+    fn about_x(p: [f64; 3], theta: f64) -> [f64; 3] {
+        let (s, c) = theta.sin_cos();
+        [p[0], c * p[1] - s * p[2], s * p[1] + c * p[2]]
+    }
+
+    #[test]
+    fn a_pair_folded_over_its_diagonal_makes_no_quad() {
+        // The diagonal s0 = (0, 0)-s1 = (1, 0); o0 = (0.5, 1) above it. With o1 = (0.5, -0.5)
+        // below, a convex kite; with o1 = (0.5, 0.5), on o0's side, the second triangle lies
+        // folded over the first, yet the sums of unsigned angles read as the kite's.
+        let [s0, s1, o0] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 1.0, 0.0]];
+        let kite = quad_eta([s0, [0.5, -0.5, 0.0], s1, o0]);
+        assert!(kite > 0.5, "{kite}");
+        assert_eq!(quad_eta([s0, [0.5, 0.5, 0.0], s1, o0]), 0.0);
+        assert!(!turns_one_way([s0, [0.5, 0.5, 0.0], s1, o0]));
+        assert!(turns_one_way([s0, [0.5, -0.5, 0.0], s1, o0]));
+        // Bent about the diagonal (the x axis): the same angles, so the same eta, while the
+        // triangles' normals stay less than 90 degrees apart; none from 90 degrees on.
+        for (deg, same) in [(30.0, true), (80.0, true), (100.0, false), (150.0, false)] {
+            let o1 = about_x([0.5, -0.5, 0.0], f64::to_radians(deg));
+            let eta = quad_eta([s0, o1, s1, o0]);
+            if same {
+                assert!((eta - kite).abs() < 1e-12, "bent {deg}: {eta} vs {kite}");
+            } else {
+                assert_eq!(eta, 0.0, "bent {deg} degrees");
+            }
+        }
+    }
+
     #[test]
     fn unit_square_has_eta_one() {
         let p = [
@@ -472,9 +535,9 @@ mod tests {
             [0.0, 1.0, 0.0],
         ];
         assert_eq!(input_quad_eta([a, b, c, d]), 1.0);
-        // Corners 1, 3, 2, 4: the halves about the diagonal overlap; read as a 180-degree
-        // fold, quad_eta alone gives 0.5.
-        assert_eq!(quad_eta([a, c, b, d]), 0.5);
+        // Corners 1, 3, 2, 4: the halves about the diagonal overlap, a 180-degree fold:
+        // quad_eta gives 0 too (its sums of unsigned angles alone read 0.5).
+        assert_eq!(quad_eta([a, c, b, d]), 0.0);
         assert_eq!(input_quad_eta([a, c, b, d]), 0.0);
     }
 
@@ -509,9 +572,10 @@ mod tests {
             let p: [[f64; 3]; 4] = std::array::from_fn(|k| dart[(k + shift) % 4]);
             assert_eq!(input_quad_eta(p), 0.0);
         }
-        // The same dart read across its other diagonal (corners 2-4) looked convex before.
+        // The same dart read across its other diagonal (corners 2-4) is a pair folded over
+        // it, which the sums of unsigned angles alone read as convex: 0 as well.
         let p: [[f64; 3]; 4] = std::array::from_fn(|k| dart[(k + 1) % 4]);
-        assert!(quad_eta(p) > 0.0);
+        assert_eq!(quad_eta(p), 0.0);
     }
 
     #[test]
@@ -548,15 +612,23 @@ mod tests {
 
     #[test]
     fn folded_quad_uses_intrinsic_3d_angles() {
-        // Two right isosceles triangles folded by 90 degrees along the diagonal (0,0,0)-(1,1,0):
-        // every 3D angle is still 90 degrees, so eta stays 1 (a planar projection would not).
+        // The unit square's triangle (0,0,0), (1,1,0), (0,1,0) turned about the diagonal
+        // (0,0,0)-(1,1,0) by theta: every 3D angle is still 90 degrees, so eta stays 1 (a
+        // planar projection would not) while the triangles' normals are less than 90 degrees
+        // apart; from 90 degrees on the pair is folded, no quad (Gmsh's minSICN of such a quad
+        // changes sign there too: 0.8 at 89 degrees, -0.8 at 91).
         let z = std::f64::consts::FRAC_1_SQRT_2;
-        let p = [
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [1.0, 1.0, 0.0],
-            [0.5, 0.5, z],
-        ];
-        assert!((quad_eta(p) - 1.0).abs() < 1e-12, "{}", quad_eta(p));
+        for (deg, want) in [
+            (0.0, 1.0),
+            (60.0, 1.0),
+            (89.0, 1.0),
+            (91.0, 0.0),
+            (120.0, 0.0),
+        ] {
+            let (s, c) = f64::to_radians(deg).sin_cos();
+            let o0 = [0.5 - 0.5 * c, 0.5 + 0.5 * c, z * s];
+            let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], o0];
+            assert!((quad_eta(p) - want).abs() < 1e-12, "{deg}: {}", quad_eta(p));
+        }
     }
 }

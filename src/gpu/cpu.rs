@@ -92,7 +92,37 @@ fn angles_from_edges([a, e0, e1, f0, f1]: [V3; 5]) -> [f32; 4] {
 
 /// eta of the quad `[s0, o1, s1, o0]`, as the kernel's `quad_eta`.
 pub fn quad_eta(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> f32 {
-    eta_from_angles(quad_angles(s0, o1, s1, o0))
+    eta_from_edges([
+        edge(s0, s1),
+        edge(s0, o0),
+        edge(s0, o1),
+        edge(s1, o0),
+        edge(s1, o1),
+    ])
+}
+
+/// The kernel's `eta_from_edges`: 0 for a pair folded over its diagonal (the triangles'
+/// normals `a x e0` and `-a x f1` 90 degrees apart or more), else eq. 1 on the angles.
+fn eta_from_edges(edges: [V3; 5]) -> f32 {
+    let [a, e0, _, _, f1] = edges;
+    if dot(cross(a, e0), cross(neg(a), f1)) <= 0.0 {
+        return 0.0;
+    }
+    eta_from_angles(angles_from_edges(edges))
+}
+
+#[inline]
+fn cross(u: V3, v: V3) -> V3 {
+    [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ]
+}
+
+#[inline]
+fn dot(u: V3, v: V3) -> f32 {
+    u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
 }
 
 fn eta_from_angles(alpha: [f32; 4]) -> f32 {
@@ -129,7 +159,7 @@ pub fn quad_quality_local(locals: &[LocalQuad]) -> Vec<f32> {
     locals
         .par_iter()
         .with_min_len(4096)
-        .map(|l| eta_from_angles(angles_from_edges(l.edges())))
+        .map(|l| eta_from_edges(l.edges()))
         .collect()
 }
 
@@ -155,6 +185,24 @@ mod tests {
         assert!(worst < 5e-7, "worst atan2 error {worst}");
         assert_eq!(atan2_pos(0.0, 0.0), 0.0);
         assert_eq!(atan2_pos(0.0, -1.0), PI);
+    }
+
+    #[test]
+    fn twin_gives_a_folded_pair_eta_zero_as_f64_does() {
+        // The second triangle (s1, s0, o1) lies folded over the first (o1 on o0's side of
+        // the diagonal): no quad, though the sums of unsigned angles read as a kite's.
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [0.5, 0.5, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.5, 1.0, 0.0],
+        ];
+        let mut b = Batch::new();
+        b.push(&pts, &[[0, 1, 2, 3]]).unwrap();
+        assert_eq!(crate::quality::quad_eta(pts), 0.0);
+        assert_eq!(quad_quality(&b), vec![0.0]);
+        let local: Vec<LocalQuad> = b.local_quads(0..1);
+        assert_eq!(quad_quality_local(&local), vec![0.0]);
     }
 
     #[test]

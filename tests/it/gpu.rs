@@ -128,6 +128,25 @@ fn angles64(p: [[f64; 3]; 4]) -> [f64; 4] {
     ]
 }
 
+/// Cosine of the angle between the normals of the quad's two triangles `(s0, s1, o0)` and
+/// `(s1, s0, o1)`: at or below 0 the pair is folded over its diagonal (no quad).
+fn fold_cos(p: [[f64; 3]; 4]) -> f64 {
+    let [s0, o1, s1, o0] = p;
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let n0 = cross(sub(s1, s0), sub(o0, s0));
+    let n1 = cross(sub(s0, s1), sub(o1, s1));
+    let dot: f64 = (0..3).map(|k| n0[k] * n1[k]).sum();
+    let norm = |n: [f64; 3]| (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    dot / (norm(n0) * norm(n1)).max(f64::MIN_POSITIVE)
+}
+
 #[derive(Debug, Default)]
 struct Report {
     n: usize,
@@ -163,12 +182,14 @@ fn compare(what: &str, points: &[[[f64; 3]; 4]], gpu_eta: &[f32], twin: &[f32]) 
             a.iter().cloned().fold(f64::MAX, f64::min),
             a.iter().cloned().fold(0.0, f64::max),
         );
-        if amax >= PI + DELTA || amin <= 0.0 {
+        let fold = fold_cos(*p);
+        if amax >= PI + DELTA || amin <= 0.0 || fold <= -DELTA {
             assert_eq!(
                 got, 0.0,
-                "{what}: candidate {i} {p:?} is non-convex (angles {a:?}) but device eta is {got}"
+                "{what}: candidate {i} {p:?} is non-convex or folded (angles {a:?}, normals' \
+                 cosine {fold}) but device eta is {got}"
             );
-        } else if amax <= PI - DELTA && amin >= DELTA {
+        } else if amax <= PI - DELTA && amin >= DELTA && fold >= DELTA {
             assert!(
                 got > 0.0,
                 "{what}: candidate {i} {p:?} is convex (angles {a:?}) but device eta is 0"
@@ -281,8 +302,13 @@ fn device_matches_f64_on_generated_and_builtin_meshes() {
         SEED + 1,
     );
     let sphere = icosphere(4);
+    // Vertices moved by up to 0.6 of a cell: triangles folded over their neighbours, whose
+    // pairs make no quad (eta 0 in f64; the sums of unsigned angles alone read them as
+    // convex).
+    let tangled = jittered_grid_mesh(30, 0.6, |_, _| 0.0, SEED + 2);
     let mut meshes = vec![
         ("jittered grid 40x40".to_string(), grid.clone()),
+        ("tangled grid 30x30".to_string(), tangled),
         ("wavy surface grid 30x30".to_string(), wavy),
         ("icosphere(4)".to_string(), sphere.clone()),
         (
