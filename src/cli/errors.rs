@@ -121,6 +121,7 @@ fn experiment_code(e: &ExperimentError) -> Option<u8> {
         | E::Extendable { .. }
         | E::AlreadyExists { .. }
         | E::MergeTargetNotEmpty { .. }
+        | E::ForeignFiles { .. }
         | E::NotADirectory { .. }
         | E::Busy { .. } => Some(EXIT_RESULTS_DIR),
         // I/O, GPU and run failures: decided by their cause, else a failure.
@@ -166,6 +167,7 @@ fn flag_wording(e: &(dyn Error + 'static)) -> Option<String> {
         e @ E::MergeTargetNotEmpty { .. } => {
             format!("{e}: choose another --out or remove that one")
         }
+        e @ E::ForeignFiles { .. } => format!("{e}; choose another --out or move them"),
         e @ E::Busy { .. } => format!("{e}; wait for it, stop it, or choose another --out"),
         E::NotADirectory { dir, kind } => format!(
             "--out {}: is {kind}, not a directory (results go into a directory)",

@@ -374,6 +374,37 @@ fn clear_results(dir: &Path) -> Result<(), ExperimentError> {
     Ok(())
 }
 
+/// Refuses a directory without a sweep's manifest that holds a file a sweep or merge writes
+/// (report, summary, the list of figures, a non-empty `figures/`): a user's own notes named
+/// `report.md` were replaced without a word. The lock, the optimum cache and any other file
+/// are no obstacle.
+pub(super) fn refuse_foreign_files(dir: &Path) -> Result<(), ExperimentError> {
+    let mut files: Vec<String> = [
+        REPORT_FILES,
+        summary::SUMMARY_CSV,
+        summary::SUMMARY_JSON,
+        ACROSS_CSV,
+        "report.md",
+        "report.html",
+    ]
+    .into_iter()
+    .filter(|name| dir.join(name).exists())
+    .map(String::from)
+    .collect();
+    let figures = dir.join(FIGURES_DIR);
+    if std::fs::read_dir(&figures).is_ok_and(|mut d| d.next().is_some()) {
+        files.push(format!("{FIGURES_DIR}/"));
+    }
+    if files.is_empty() {
+        Ok(())
+    } else {
+        Err(ExperimentError::ForeignFiles {
+            dir: dir.to_path_buf(),
+            files,
+        })
+    }
+}
+
 /// File in a results directory listing the figures its report wrote, one relative path a
 /// line, so that `--overwrite` and the next report remove those and no other file.
 pub const REPORT_FILES: &str = "report-files.txt";
@@ -474,6 +505,11 @@ pub fn run(
     let dir = &opts.dir;
     std::fs::create_dir_all(dir).map_err(|e| ExperimentError::io(dir, e))?;
     let _lock = super::lock::DirLock::acquire(dir)?;
+    // A directory that is no sweep's keeps what it holds (`--overwrite` too replaces only a
+    // sweep's files).
+    if !dir.join(MANIFEST_FILE).exists() {
+        refuse_foreign_files(dir)?;
+    }
     if opts.overwrite && !opts.resume {
         clear_results(dir)?;
     }

@@ -84,6 +84,21 @@ pub enum ExperimentError {
         /// Records found.
         records: usize,
     },
+    /// A sweep or merge was pointed at a directory without a sweep's manifest that holds
+    /// files it would write (a report, a summary, figures): someone else's, which it would
+    /// replace.
+    #[error(
+        "{dir}: holds {} that a sweep writes, but no sweep's {}: they are not a sweep's \
+         results, and nothing is written over them",
+        files.join(", "),
+        manifest::MANIFEST_FILE
+    )]
+    ForeignFiles {
+        /// The directory.
+        dir: PathBuf,
+        /// The files in the way (relative to `dir`).
+        files: Vec<String>,
+    },
     /// `merge` was pointed at a directory that already holds runs.
     #[error("{dir}: already holds {records} run(s); merge writes into a new or empty directory")]
     MergeTargetNotEmpty {

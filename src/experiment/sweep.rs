@@ -66,6 +66,12 @@ pub fn mesh_name(spec: &str) -> String {
 /// under the results directory) the optimum of each mesh. How the backend was chosen goes
 /// to `events`.
 pub fn prepare(config: &SweepConfig, events: &mut Events<'_>) -> Result<Prepared, ExperimentError> {
+    // Before anything is written there (the optimum's cache): a directory that is no sweep's
+    // and holds files a sweep writes is refused (the engine checks again under its lock).
+    let out = config.out();
+    if out.is_dir() && !out.join(super::manifest::MANIFEST_FILE).exists() {
+        super::engine::refuse_foreign_files(out)?;
+    }
     let mut phases = PhaseTimes::default();
     let clock = std::time::Instant::now();
     let mut meshes = Vec::new();

@@ -119,6 +119,72 @@ fn exit_4_results_directory() {
     );
 }
 
+/// A directory that no sweep made keeps its files: a sweep or a merge pointed at one that
+/// holds a report, a summary or figures of the user's own is refused (exit 4) before
+/// anything is written there, naming them; they were replaced without a word.
+#[test]
+fn a_users_own_report_and_summary_are_not_written_over() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let notes = dir.join("paper");
+    std::fs::create_dir(&notes).unwrap();
+    std::fs::write(notes.join("report.md"), "# My paper notes\n").unwrap();
+    std::fs::write(notes.join("summary.csv"), "a,b\n").unwrap();
+    std::fs::write(notes.join("data.txt"), "mine\n").unwrap();
+    let err = fails_with(dir, &sweep_args("paper"), 4, "summary.csv, report.md");
+    assert!(err.contains("not a sweep's results"), "{err}");
+    let mut over = sweep_args("paper");
+    over.push("--overwrite");
+    fails_with(dir, &over, 4, "summary.csv, report.md");
+    let names: Vec<String> = std::fs::read_dir(&notes)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names.len(),
+        3,
+        "the sweep wrote into the directory: {names:?}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(notes.join("report.md")).unwrap(),
+        "# My paper notes\n"
+    );
+    // Figures alone are in the way too; other files are not.
+    std::fs::remove_file(notes.join("report.md")).unwrap();
+    std::fs::remove_file(notes.join("summary.csv")).unwrap();
+    std::fs::create_dir(notes.join("figures")).unwrap();
+    std::fs::write(notes.join("figures").join("plot.svg"), "<svg/>").unwrap();
+    fails_with(dir, &sweep_args("paper"), 4, "figures/");
+    std::fs::remove_dir_all(notes.join("figures")).unwrap();
+    let ok = run_in(dir, &sweep_args("paper"));
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    assert_eq!(
+        std::fs::read_to_string(notes.join("data.txt")).unwrap(),
+        "mine\n"
+    );
+    // merge: shards into a directory holding the user's report.
+    for (k, shard) in ["1/2", "2/2"].iter().enumerate() {
+        let name = format!("s{k}");
+        let mut args = sweep_args(&name);
+        args.extend(["--shard", shard]);
+        let out = run_in(dir, &args);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let target = dir.join("merged");
+    std::fs::create_dir(&target).unwrap();
+    std::fs::write(target.join("report.md"), "# My notes\n").unwrap();
+    fails_with(
+        dir,
+        &["merge", "s0", "s1", "--out", "merged"],
+        4,
+        "report.md",
+    );
+    assert_eq!(
+        std::fs::read_to_string(target.join("report.md")).unwrap(),
+        "# My notes\n"
+    );
+}
+
 /// The library's notices reach stderr through the command: the backend `--backend auto` picked, once,
 /// and the resume; `-q` keeps only warnings: the backend line where it is a fallback (no GPU
 /// here: lavapipe or the CPU twin), not the progress, the resume or the summary.

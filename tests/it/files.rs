@@ -263,7 +263,7 @@ fn an_output_that_is_the_input_is_refused() {
 }
 
 /// Item 2: `sweep --overwrite` into a directory that was never a sweep's deletes nothing of
-/// it; into a sweep's directory it deletes the sweep's files and the figures its report
+/// it (and, holding files of a report's names, is refused); into a sweep's directory it deletes the sweep's files and the figures its report
 /// listed, nothing else (a file of the user's in `figures/` stays).
 #[test]
 fn overwrite_deletes_only_what_a_sweep_wrote() {
@@ -292,17 +292,16 @@ fn overwrite_deletes_only_what_a_sweep_wrote() {
         "--backend",
         "cpu",
     ];
+    // Refused (exit 4): its report, summary and figures are the user's, and the sweep
+    // would write files of those names (its summary replaced the user's before).
     let o = run_in(tmp.path(), &args);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let after = snapshot(&p);
-    for (name, bytes) in &before {
-        if name != "summary.csv" {
-            assert!(
-                after.contains(&(name.clone(), bytes.clone())),
-                "{name} was touched"
-            );
-        }
-    }
+    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("not a sweep's results"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(snapshot(&p), before, "the directory was touched");
 
     // A sweep's directory with a report, and a file of the user's among its figures.
     let d = small_sweep(tmp.path(), "d", &[]);
