@@ -262,7 +262,7 @@ pub fn write_mesh_output(
     mesh: &quadrecomb::internals::mesh::Mesh,
     rec: &quadrecomb::internals::mesh::Recombined,
     vtu_ascii: bool,
-) -> Result<(), UsageError> {
+) -> anyhow::Result<()> {
     use quadrecomb::internals::mesh::vtu::Encoding;
     let vtu = output_kind(path) == Some(true);
     let encoding = if vtu_ascii {
@@ -277,10 +277,13 @@ pub fn write_mesh_output(
             quadrecomb::internals::mesh::msh::write_to(&mut w, mesh, rec)
         }
     })
+    // A failure of the system (disk full, the directory gone), not of the command line:
+    // exit 1, as for any file the system cannot write (the arguments were checked before the
+    // work, `check_output_place`).
     .map_err(|e| {
-        UsageError(format!(
+        anyhow::anyhow!(
             "cannot write output {} (through a temporary file beside it): {e}",
             path.display()
-        ))
+        )
     })
 }

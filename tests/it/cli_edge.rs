@@ -185,6 +185,25 @@ fn a_users_own_report_and_summary_are_not_written_over() {
     );
 }
 
+/// Writing `-o` failing after the work (here a file-size limit, as a full disk) is a failure
+/// of the system, exit 1, not a usage error (exit 2, as it was), and leaves no file.
+#[test]
+fn a_failed_write_after_the_work_exits_1() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg("trap '' XFSZ; ulimit -f 1; exec \"$0\" recombine sphere --algo greedy -o out.msh")
+        .arg(crate::util::bin())
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot write output out.msh"), "{err}");
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
 /// The library's notices reach stderr through the command: the backend `--backend auto` picked, once,
 /// and the resume; `-q` keeps only warnings: the backend line where it is a fallback (no GPU
 /// here: lavapipe or the CPU twin), not the progress, the resume or the summary.
