@@ -195,6 +195,15 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), UsageError> {
     if p.is_dir() || p.as_os_str().to_string_lossy().ends_with('/') {
         return bad("names a directory, not a file".into());
     }
+    // A FIFO, socket or device there is refused before the work, not after it.
+    if let Ok(meta) = std::fs::metadata(p)
+        && !meta.is_file()
+    {
+        return bad(format!(
+            "exists and is {}, not a regular file: refusing to replace it",
+            quadrecomb::internals::mesh::file_kind(&meta)
+        ));
+    }
     let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
     match dir {
         Some(d) if d.exists() && !d.is_dir() => bad(format!("{} is not a directory", d.display())),
@@ -279,11 +288,16 @@ pub fn write_mesh_output(
     })
     // A failure of the system (disk full, the directory gone), not of the command line:
     // exit 1, as for any file the system cannot write (the arguments were checked before the
-    // work, `check_output_place`).
+    // work, `check_output_place`); a FIFO or device put at `path` since is refused as there.
     .map_err(|e| {
-        anyhow::anyhow!(
+        let msg = format!(
             "cannot write output {} (through a temporary file beside it): {e}",
             path.display()
-        )
+        );
+        if e.kind() == std::io::ErrorKind::InvalidInput {
+            UsageError(msg).into()
+        } else {
+            anyhow::anyhow!(msg)
+        }
     })
 }
