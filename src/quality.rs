@@ -83,39 +83,6 @@ fn folded(p: [[f64; 3]; 4]) -> bool {
     dot(unit_range(n0), unit_range(n1)) <= 0.0
 }
 
-/// Whether every corner of the quad `p` (a cycle of four points) turns the same way about
-/// the quad's vector area (Newell's normal): true for a strictly convex quad, planar or
-/// gently curved; false for a reflex corner, a self-intersecting "bowtie" or a pair of
-/// triangles folded onto each other.
-pub fn turns_one_way(p: [[f64; 3]; 4]) -> bool {
-    turning(p).is_some()
-}
-
-/// The quad `p` relative to its centroid and scaled to unit size (so that neither the
-/// products nor the test depend on the coordinates' magnitude) when its corners all turn
-/// one way ([`turns_one_way`]), else `None`.
-fn turning(p: [[f64; 3]; 4]) -> Option<[[f64; 3]; 4]> {
-    use crate::mesh::topology::{cross, dot, sub};
-    let c = [0, 1, 2].map(|k| p.iter().map(|v| v[k]).sum::<f64>() / 4.0);
-    let rel = p.map(|v| sub(v, c));
-    let m = rel.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-    if m == 0.0 || !m.is_finite() {
-        return None;
-    }
-    let q = rel.map(|v| v.map(|x| x / m));
-    let mut normal = [0.0; 3];
-    for k in 0..4 {
-        let x = cross(q[k], q[(k + 1) % 4]);
-        normal = [normal[0] + x[0], normal[1] + x[1], normal[2] + x[2]];
-    }
-    (0..4)
-        .all(|k| {
-            let (prev, here, next) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
-            dot(cross(sub(here, prev), sub(next, here)), normal) > 0.0
-        })
-        .then_some(q)
-}
-
 /// eta of a quad given as a cycle of four corners, as a mesh file holds it: eq. 1 on its four
 /// corner angles (the angle between the two sides meeting at each corner), whichever diagonal
 /// a writer had in mind. A corner that turns against the quad's orientation (a reflex corner,
@@ -124,10 +91,29 @@ fn turning(p: [[f64; 3]; 4]) -> Option<[[f64; 3]; 4]> {
 /// Recombined candidates are read across their diagonal instead ([`quad_eta`]): on a planar
 /// quad both give the same value (both 0 for a pair folded over its diagonal).
 pub fn input_quad_eta(p: [[f64; 3]; 4]) -> f64 {
-    let Some(q) = turning(p) else {
+    use crate::mesh::topology::{cross, dot, sub};
+    // Relative to the centroid, scaled to unit size, so that neither the products below nor
+    // the tolerance depend on the coordinates' magnitude.
+    let c = [0, 1, 2].map(|k| p.iter().map(|v| v[k]).sum::<f64>() / 4.0);
+    let rel = p.map(|v| sub(v, c));
+    let m = rel.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    if m == 0.0 || !m.is_finite() {
         return 0.0;
-    };
-    let alpha: [f64; 4] = std::array::from_fn(|k| angle(q[k], q[(k + 3) % 4], q[(k + 1) % 4]));
+    }
+    let q = rel.map(|v| v.map(|x| x / m));
+    let mut normal = [0.0; 3];
+    for k in 0..4 {
+        let x = cross(q[k], q[(k + 1) % 4]);
+        normal = [normal[0] + x[0], normal[1] + x[1], normal[2] + x[2]];
+    }
+    let mut alpha = [0.0; 4];
+    for k in 0..4 {
+        let (prev, here, next) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
+        if dot(cross(sub(here, prev), sub(next, here)), normal) <= 0.0 {
+            return 0.0;
+        }
+        alpha[k] = angle(here, prev, next);
+    }
     eta_from_angles(alpha)
 }
 
@@ -475,8 +461,7 @@ mod tests {
         let kite = quad_eta([s0, [0.5, -0.5, 0.0], s1, o0]);
         assert!(kite > 0.5, "{kite}");
         assert_eq!(quad_eta([s0, [0.5, 0.5, 0.0], s1, o0]), 0.0);
-        assert!(!turns_one_way([s0, [0.5, 0.5, 0.0], s1, o0]));
-        assert!(turns_one_way([s0, [0.5, -0.5, 0.0], s1, o0]));
+        assert_eq!(input_quad_eta([s0, [0.5, 0.5, 0.0], s1, o0]), 0.0);
         // Bent about the diagonal (the x axis): the same angles, so the same eta, while the
         // triangles' normals stay less than 90 degrees apart; none from 90 degrees on.
         for (deg, same) in [(30.0, true), (80.0, true), (100.0, false), (150.0, false)] {

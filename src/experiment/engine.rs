@@ -377,8 +377,11 @@ fn clear_results(dir: &Path) -> Result<(), ExperimentError> {
 /// Refuses a directory without a sweep's manifest that holds a file a sweep or merge writes
 /// (report, summary, the list of figures, a non-empty `figures/`): a user's own notes named
 /// `report.md` were replaced without a word. The lock, the optimum cache and any other file
-/// are no obstacle.
+/// are no obstacle, nor is anything in a sweep's own directory.
 pub(super) fn refuse_foreign_files(dir: &Path) -> Result<(), ExperimentError> {
+    if dir.join(MANIFEST_FILE).exists() {
+        return Ok(());
+    }
     let mut files: Vec<String> = [
         REPORT_FILES,
         summary::SUMMARY_CSV,
@@ -507,9 +510,7 @@ pub fn run(
     let _lock = super::lock::DirLock::acquire(dir)?;
     // A directory that is no sweep's keeps what it holds (`--overwrite` too replaces only a
     // sweep's files).
-    if !dir.join(MANIFEST_FILE).exists() {
-        refuse_foreign_files(dir)?;
-    }
+    refuse_foreign_files(dir)?;
     if opts.overwrite && !opts.resume {
         clear_results(dir)?;
     }

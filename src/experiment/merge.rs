@@ -183,9 +183,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
             records: existing.records.len(),
         });
     }
-    if !out.join(super::manifest::MANIFEST_FILE).exists() {
-        super::engine::refuse_foreign_files(out)?;
-    }
+    super::engine::refuse_foreign_files(out)?;
     let mut manifest = first.clone();
     manifest.spec = spec.clone();
     manifest.shard = None;

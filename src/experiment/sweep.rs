@@ -69,7 +69,7 @@ pub fn prepare(config: &SweepConfig, events: &mut Events<'_>) -> Result<Prepared
     // Before anything is written there (the optimum's cache): a directory that is no sweep's
     // and holds files a sweep writes is refused (the engine checks again under its lock).
     let out = config.out();
-    if out.is_dir() && !out.join(super::manifest::MANIFEST_FILE).exists() {
+    if out.is_dir() {
         super::engine::refuse_foreign_files(out)?;
     }
     let mut phases = PhaseTimes::default();

@@ -55,13 +55,8 @@ fn atan2_pos(y: f32, x: f32) -> f32 {
 
 #[inline]
 fn angle(u: V3, v: V3) -> f32 {
-    let c = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let cn = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-    atan2_pos(cn, u[0] * v[0] + u[1] * v[1] + u[2] * v[2])
+    let c = cross(u, v);
+    atan2_pos(dot(c, c).sqrt(), dot(u, v))
 }
 
 #[inline]
@@ -69,15 +64,15 @@ fn neg(u: V3) -> V3 {
     u.map(|x| -x)
 }
 
-/// The four interior angles of the quad `[s0, o1, s1, o0]` as the kernel computes them.
-pub fn quad_angles(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> [f32; 4] {
-    angles_from_edges([
+/// The kernel's edge vectors `[a, e0, e1, f0, f1]` of the quad `[s0, o1, s1, o0]`.
+fn quad_edges(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> [V3; 5] {
+    [
         edge(s0, s1),
         edge(s0, o0),
         edge(s0, o1),
         edge(s1, o0),
         edge(s1, o1),
-    ])
+    ]
 }
 
 /// The kernel's `eta_from_edges` angles from `[a, e0, e1, f0, f1]`.
@@ -92,13 +87,7 @@ fn angles_from_edges([a, e0, e1, f0, f1]: [V3; 5]) -> [f32; 4] {
 
 /// eta of the quad `[s0, o1, s1, o0]`, as the kernel's `quad_eta`.
 pub fn quad_eta(s0: &Vertex, o1: &Vertex, s1: &Vertex, o0: &Vertex) -> f32 {
-    eta_from_edges([
-        edge(s0, s1),
-        edge(s0, o0),
-        edge(s0, o1),
-        edge(s1, o0),
-        edge(s1, o1),
-    ])
+    eta_from_edges(quad_edges(s0, o1, s1, o0))
 }
 
 /// The kernel's `eta_from_edges`: 0 for a pair folded over its diagonal (the triangles'

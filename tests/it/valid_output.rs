@@ -261,8 +261,8 @@ fn pairs_folded_over_their_diagonal_make_no_quad() {
         all.extend_from_slice(&["-o", "raw.msh"]);
         assert!(run_in(dir, &all).status.success(), "{all:?}");
         python(
-            &MOVE.replace("sys.argv[3]", &format!("{how:?}")),
-            &[&dir.join("raw.msh"), &dir.join(file)],
+            MOVE,
+            &[&dir.join("raw.msh"), &dir.join(file), Path::new(how)],
         );
     }
     // Two triangles, the second folded over the first (node 4 on node 3's side of edge 1-2).
