@@ -47,11 +47,12 @@ pub enum MeshError {
     #[error("triangle {element} duplicates triangle {first} (same three nodes)")]
     DuplicateTriangle { element: u64, first: u64 },
     #[error(
-        "non-manifold edge between nodes {a} and {b}: shared by {count} elements (first ones: {elements:?})"
+        "non-manifold edge between nodes {a} and {b}: shared by {count} elements of surface {surface} (first ones: {elements:?}; elements of different surfaces may share an edge, at most two of one surface)"
     )]
     NonManifoldEdge {
         a: u64,
         b: u64,
+        surface: i32,
         count: usize,
         elements: Vec<u64>,
     },

@@ -165,32 +165,57 @@ impl HalfEdges {
         None
     }
 
-    /// The error for a mesh with non-manifold edges, the same whatever the order of the
-    /// nodes and elements (the file's, or the spatial order of a loaded mesh): the edge
-    /// with the smallest node tags, its nodes in increasing tag, its first elements in
-    /// increasing tag.
-    fn non_manifold(&self, vertex_ids: &[u64], element_id: impl Fn(u32) -> u64) -> MeshError {
-        let mut worst: Option<(u64, u64, Vec<u64>)> = None;
+    /// The error for a mesh with a non-manifold edge (more than two elements of one surface
+    /// on it: [`overfull_surface`]), the same whatever the order of the nodes and elements (the
+    /// file's, or the spatial order of a loaded mesh): the edge with the smallest node tags,
+    /// its nodes in increasing tag, the surface with the smallest tag among those overfull
+    /// there, its first elements on that surface in increasing tag.
+    fn non_manifold(
+        &self,
+        vertex_ids: &[u64],
+        element_id: impl Fn(u32) -> u64,
+        surface_of: impl Fn(u32) -> i32,
+    ) -> MeshError {
+        let mut worst: Option<(u64, u64, i32, Vec<u64>)> = None;
         for (a, b, group) in self.groups() {
-            if group.len() <= 2 {
+            let Some(surface) = overfull_surface(group, &surface_of) else {
                 continue;
-            }
+            };
             let (ta, tb) = (vertex_ids[a as usize], vertex_ids[b as usize]);
             let key = (ta.min(tb), ta.max(tb));
             if worst.as_ref().is_none_or(|w| key < (w.0, w.1)) {
-                let mut elements: Vec<u64> = group.iter().map(|h| element_id(h.1)).collect();
+                let mut elements: Vec<u64> = group
+                    .iter()
+                    .filter(|h| surface_of(h.1) == surface)
+                    .map(|h| element_id(h.1))
+                    .collect();
                 elements.sort_unstable();
-                worst = Some((key.0, key.1, elements));
+                worst = Some((key.0, key.1, surface, elements));
             }
         }
-        let (a, b, elements) = worst.expect("a non-manifold edge");
+        let (a, b, surface, elements) = worst.expect("a non-manifold edge");
         MeshError::NonManifoldEdge {
             a,
             b,
+            surface,
             count: elements.len(),
             elements: elements.into_iter().take(4).collect(),
         }
     }
+}
+
+/// The smallest surface tag with more than two of `group`'s elements (the sides of one
+/// edge), if any. Elements of different surfaces may share an edge in any number (three
+/// panels meeting along a line, a stiffener on a plate: each surface stays a manifold, and
+/// the dual graph does not cross from one surface to another); two of one surface are
+/// neighbours, a third would leave no neighbour to tell.
+fn overfull_surface(group: &[(u32, u32)], surface_of: impl Fn(u32) -> i32) -> Option<i32> {
+    if group.len() <= 2 {
+        return None;
+    }
+    let mut surfaces: Vec<i32> = group.iter().map(|h| surface_of(h.1)).collect();
+    surfaces.sort_unstable();
+    surfaces.windows(3).find(|w| w[0] == w[2]).map(|w| w[0])
 }
 
 /// The side of triangle `tri` whose ends are `a` and `b` (in either direction).
@@ -267,20 +292,31 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             data.quad_ids[e - nt]
         }
     };
+    let surface_of = |e: u32| -> i32 {
+        let e = e as usize;
+        if e < nt {
+            data.triangle_surface[e]
+        } else {
+            data.quad_surface[e - nt]
+        }
+    };
     let mut neighbours = vec![[NONE; 3]; nt];
     let (mut num_edges, mut num_boundary_edges) = (0, 0);
     for (a, b, group) in half.groups() {
-        if group.len() > 2 {
-            return Err(half.non_manifold(&data.vertex_ids, element_id));
+        if overfull_surface(group, surface_of).is_some() {
+            return Err(half.non_manifold(&data.vertex_ids, element_id, surface_of));
         }
         num_edges += 1;
         num_boundary_edges += usize::from(group.len() == 1);
         let side = |t: u32| side_of(data.triangles[t as usize], a, b);
-        if let [(_, t), (_, u)] = *group {
-            let (ti, ui) = (t as usize, u as usize);
-            if ti < nt && ui < nt && data.triangle_surface[ti] == data.triangle_surface[ui] {
-                neighbours[ti][side(t)] = u;
-                neighbours[ui][side(u)] = t;
+        // Two triangles of one surface on the edge are neighbours (at most two per surface).
+        for (i, &(_, t)) in group.iter().enumerate() {
+            for &(_, u) in &group[i + 1..] {
+                let (ti, ui) = (t as usize, u as usize);
+                if ti < nt && ui < nt && surface_of(t) == surface_of(u) {
+                    neighbours[ti][side(t)] = u;
+                    neighbours[ui][side(u)] = t;
+                }
             }
         }
     }
@@ -566,7 +602,7 @@ mod tests {
         data.triangle_surface = vec![1; 5];
         let want = Mesh::new(data.clone()).unwrap_err();
         assert!(
-            matches!(&want, MeshError::NonManifoldEdge { a: 1, b: 3, count: 3, elements } if elements == &[10, 11, 12]),
+            matches!(&want, MeshError::NonManifoldEdge { a: 1, b: 3, surface: 1, count: 3, elements } if elements == &[10, 11, 12]),
             "{want}"
         );
         // Nodes and triangles in reverse order.
@@ -579,6 +615,55 @@ mod tests {
         data.triangles.reverse();
         data.triangle_ids.reverse();
         assert_eq!(Mesh::new(data).unwrap_err(), want);
+    }
+
+    /// Surfaces may meet at an edge in any number, each with at most two triangles there:
+    /// the dual graph joins the two of one surface and nothing across surfaces.
+    #[test]
+    fn surfaces_meet_at_an_edge_each_a_manifold() {
+        // The square's diagonal 0-2 with fins standing on it: above at node 4, below at 5.
+        let with = |fins: &[([u32; 3], i32)], square_surfaces: [i32; 2]| {
+            let mut data = square([0, 2, 3]);
+            data.vertices.push([1.0, 1.0, 1.0]);
+            data.vertices.push([1.0, 1.0, -1.0]);
+            data.triangle_surface = square_surfaces.to_vec();
+            for &(tri, surface) in fins {
+                data.triangles.push(tri);
+                data.triangle_surface.push(surface);
+            }
+            Mesh::new(data)
+        };
+        let check = |mesh: Result<Mesh, MeshError>, dual_edges, mut sizes: Vec<u32>| {
+            let mesh = mesh.unwrap();
+            mesh.sanity_check().unwrap();
+            assert_eq!(mesh.topology.num_dual_edges(), dual_edges);
+            let mut got = mesh.topology.component_sizes.clone();
+            got.sort_unstable();
+            sizes.sort_unstable();
+            assert_eq!(got, sizes);
+            // The diagonal is no boundary edge: more than one element uses it.
+            assert_eq!(
+                mesh.topology.num_boundary_edges,
+                mesh.topology.num_edges - 1
+            );
+        };
+        // One triangle of each of three surfaces (a T: a web on the line between two panels).
+        check(with(&[([0, 2, 4], 3)], [1, 2]), 0, vec![1, 1, 1]);
+        // Two of the plate's and one of a fin's.
+        check(with(&[([0, 2, 4], 2)], [1, 1]), 1, vec![2, 1]);
+        // Two of each (a wall through the plate).
+        check(
+            with(&[([0, 2, 4], 2), ([0, 2, 5], 2)], [1, 1]),
+            2,
+            vec![2, 2],
+        );
+        // Three of one surface beside one of another: that surface is no manifold there.
+        let err = with(&[([0, 2, 4], 1), ([0, 2, 5], 2)], [1, 1]).unwrap_err();
+        assert!(
+            matches!(&err, MeshError::NonManifoldEdge { a: 1, b: 3, surface: 1, count: 3, elements } if elements == &[1, 2, 3]),
+            "{err}"
+        );
+        assert!(err.to_string().contains("3 elements of surface 1"), "{err}");
     }
 
     #[test]

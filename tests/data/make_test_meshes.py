@@ -124,3 +124,30 @@ for _, s in gmsh.model.getEntities(2):
 write("channel_41_ascii.msh", 4.1, 0)
 write("channel_22_ascii.msh", 2.2, 0)
 gmsh.finalize()
+
+# Surfaces meeting three at an edge (tests/it/model.rs, valid_output.rs): a plate cut along
+# y = 0 by a web standing on that line (the two halves of the plate and the web each have
+# one triangle on every edge of the line), and a fin standing on the plate's upper half
+# along a line inside it (two of the plate's triangles and one of the fin's on each edge).
+# Named groups for the plate (both halves), the web, the fin and the plate's clamped edge
+# x = 0.
+start("stiffened")
+occ = gmsh.model.occ
+plate = occ.addRectangle(0, -1, 0, 3, 2)
+web = occ.addRectangle(0, 0, 0, 3, 0.8)
+occ.rotate([(2, web)], 0, 0, 0, 1, 0, 0, 1.5707963267948966)
+fin = occ.addRectangle(1.5, 0.3, 0, 0.6, 0.5)
+occ.rotate([(2, fin)], 1.5, 0.3, 0, 0, 1, 0, -1.5707963267948966)
+occ.fragment([(2, plate)], [(2, web), (2, fin)])
+mesh(0.2)
+parts = {"plate": [], "web": [], "fin": []}
+for _, s in gmsh.model.getEntities(2):
+    x, y, z = occ.getCenterOfMass(2, s)
+    parts["plate" if abs(z) < 1e-9 else "web" if abs(y) < 1e-9 else "fin"].append(s)
+for name, surfaces in parts.items():
+    gmsh.model.addPhysicalGroup(2, surfaces, name=name)
+clamped = [c for _, c in gmsh.model.getEntities(1)
+           if abs(occ.getCenterOfMass(1, c)[0]) < 1e-9 and abs(occ.getCenterOfMass(1, c)[2]) < 1e-9]
+gmsh.model.addPhysicalGroup(1, clamped, name="clamped")
+write("stiffened_41_ascii.msh", 4.1, 0)
+gmsh.finalize()

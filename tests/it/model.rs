@@ -134,7 +134,8 @@ fn relative(a: f64, b: f64) -> f64 {
 /// and the nodes on every entity are those Gmsh reads from the input, for MSH 4.1 and 2.2
 /// inputs with named groups and boundary lines (the channel: groups for both surfaces and
 /// for the inlet, outlet and walls) and for the built-in meshes (physical surfaces only,
-/// nodes on their curves and points without line elements).
+/// nodes on their curves and points without line elements), and for a stiffened plate
+/// (surfaces meeting three at an edge).
 #[test]
 fn written_msh_keeps_the_gmsh_model() {
     if !gmsh_available() {
@@ -146,6 +147,8 @@ fn written_msh_keeps_the_gmsh_model() {
         "channel_22_ascii.msh",
         "sphere",
         "two_squares_41_bin.msh",
+        // Three surfaces meeting at the edges of a line (a web on a plate, a fin on it).
+        "stiffened_41_ascii.msh",
     ] {
         let (m, path) = load(name);
         let (out, rec) = write_recombined(dir.path(), "out.msh", &m, Rule::default());

@@ -18,7 +18,7 @@ mod state;
 mod tree;
 mod walk;
 
-use meshes::{Diagonals, Grid, Surfaces};
+use meshes::{Diagonals, Fin, Grid, Surfaces};
 use naive::Naive;
 use quadrecomb::internals::mesh::generate::{self, Corridor};
 use quadrecomb::internals::mesh::{Mesh, MeshData, NONE};
@@ -270,6 +270,25 @@ fn oracle_sample_meshes_cover_the_cases() {
             .any(|(_, m)| m.topology.component_sizes.len() > 3),
         "a mesh in pieces"
     );
+    // Elements on each edge, counted apart from the library's topology.
+    let most_on_an_edge = |m: &Mesh| {
+        let mut on: std::collections::HashMap<(u32, u32), usize> = Default::default();
+        for t in &m.triangles {
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                *on.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        on.into_values().max().unwrap_or(0)
+    };
+    assert!(
+        all.iter().any(|(_, m)| most_on_an_edge(m) == 3),
+        "a mesh with three surfaces' triangles on an edge"
+    );
+    assert!(
+        all.iter().any(|(_, m)| most_on_an_edge(m) == 4),
+        "a mesh with two surfaces' two triangles each on an edge"
+    );
     assert!(
         all.iter().any(|(_, m)| m.num_triangles() >= 180),
         "a mesh of a couple of hundred triangles"
@@ -501,6 +520,38 @@ fn sample_meshes(seed: u64) -> Vec<(String, Mesh)> {
         if let Some(mesh) = spec.build() {
             out.push((format!("{spec:?}"), mesh));
         }
+    }
+    // Surfaces meeting three or more at an edge: a wall standing on a one-surface grid (two
+    // grid triangles and one of the wall's on each edge of the line), on the line between
+    // two quadrants (one of each surface), and through a grid (two of each).
+    let fin = |j, i0, i1, levels, surface, through| Fin {
+        j,
+        i0,
+        i1,
+        levels,
+        surface,
+        through,
+    };
+    let finned = [
+        Grid {
+            fins: vec![fin(4, 1, 8, 2, 7, false)],
+            ..grid(10, 8, 10)
+        },
+        Grid {
+            holes: 0.05,
+            surfaces: Surfaces::Quadrants,
+            fins: vec![fin(4, 0, 10, 1, 9, false), fin(1, 2, 6, 3, 8, false)],
+            ..grid(10, 8, 11)
+        },
+        Grid {
+            drop: 0.02,
+            fins: vec![fin(3, 2, 7, 2, 5, true)],
+            ..grid(9, 7, 12)
+        },
+    ];
+    for spec in finned {
+        let mesh = spec.build().expect("a finned grid");
+        out.push((format!("{spec:?}"), mesh));
     }
     out.push(("icosphere(1)".into(), meshes::icosphere(1)));
     // Long thin polders (one-cell corridors): splits with parts over LONG_PART triangles,

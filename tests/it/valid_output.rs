@@ -1,8 +1,8 @@
 //! The valid-quad rule as a user checks it: every quad in every written mesh (each policy and
-//! the optimum, on `borouchaki`, `sphere` and generated meshes) is strictly convex, judged from
+//! the optimum, on `borouchaki`, `sphere`, generated meshes and a stiffened plate) is strictly convex, judged from
 //! the file as Gmsh reads it, not from our eta.
 
-use crate::util::{gmsh_available, python, run_in};
+use crate::util::{gmsh_available, python, repo_path, run_in};
 use std::path::Path;
 
 /// Reads a mesh with Gmsh's Python API and prints `quads non_convex`: a quad is strictly
@@ -92,7 +92,10 @@ fn every_written_quad_is_strictly_convex() {
         &["--algo", "uniform", "--horizon", "1"],
     ];
     let mut checked = 0;
-    for mesh in ["borouchaki", "sphere", "grid.msh", "ico.msh"] {
+    // Surfaces meeting three at an edge: a web and a fin standing on a plate.
+    let stiffened = repo_path("tests/data/stiffened_41_ascii.msh");
+    let stiffened = stiffened.to_str().unwrap();
+    for mesh in ["borouchaki", "sphere", "grid.msh", "ico.msh", stiffened] {
         for (k, policy) in policies.iter().enumerate() {
             let mut args = vec!["recombine", mesh, "--no-optimum"];
             args.extend_from_slice(policy);

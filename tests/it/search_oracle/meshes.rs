@@ -71,7 +71,23 @@ pub struct Grid {
     pub surfaces: Surfaces,
     /// Cells whose diagonal is flipped after `diagonals` is applied.
     pub flip: Vec<(usize, usize)>,
+    /// Walls standing on grid lines, out of the plane (other surfaces meeting the grid's).
+    pub fins: Vec<Fin>,
     pub seed: u64,
+}
+
+/// A wall of triangles standing on the grid line `y = j` (row of vertices `j`) from column
+/// `i0` to `i1`, `levels` cells high (in z), on surface `surface`, its cells' diagonals drawn
+/// at random; `through` also puts it below the plane (same surface), so that the wall has
+/// two triangles on each of the line's edges as the grid has.
+#[derive(Debug, Clone)]
+pub struct Fin {
+    pub j: usize,
+    pub i0: usize,
+    pub i1: usize,
+    pub levels: usize,
+    pub surface: i32,
+    pub through: bool,
 }
 
 impl Grid {
@@ -87,6 +103,7 @@ impl Grid {
             quads: 0.0,
             surfaces: Surfaces::One,
             flip: Vec::new(),
+            fins: Vec::new(),
             seed: 0,
         }
     }
@@ -163,6 +180,46 @@ impl Grid {
                         _ => surface,
                     });
                 }
+            }
+        }
+        for fin in &self.fins {
+            assert!(
+                fin.i0 < fin.i1 && fin.i1 <= nx && fin.j <= ny,
+                "{fin:?} off the grid"
+            );
+            let mut row = |sign: f64| {
+                // Vertex ids of the wall's level k (level 0 is the grid's line).
+                let mut levels = vec![(fin.i0..=fin.i1).map(|i| vid(i, fin.j)).collect::<Vec<_>>()];
+                for k in 1..=fin.levels {
+                    levels.push(
+                        (fin.i0..=fin.i1)
+                            .map(|i| {
+                                let [x, y, _] = vertices[vid(i, fin.j) as usize];
+                                vertices.push([x, y, sign * k as f64]);
+                                vertices.len() as u32 - 1
+                            })
+                            .collect(),
+                    );
+                }
+                for k in 0..fin.levels {
+                    for i in 0..fin.i1 - fin.i0 {
+                        let (a, b) = (levels[k][i], levels[k][i + 1]);
+                        let (c, d) = (levels[k + 1][i + 1], levels[k + 1][i]);
+                        let pair = if rng.random_bool(0.5) {
+                            [[a, b, c], [a, c, d]]
+                        } else {
+                            [[a, b, d], [b, c, d]]
+                        };
+                        for tri in pair {
+                            triangles.push(tri);
+                            triangle_surface.push(fin.surface);
+                        }
+                    }
+                }
+            };
+            row(1.0);
+            if fin.through {
+                row(-1.0);
             }
         }
         if triangles.is_empty() {

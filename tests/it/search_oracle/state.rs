@@ -319,6 +319,7 @@ fn grids() -> impl Strategy<Value = Grid> {
                 quads,
                 surfaces,
                 flip: Vec::new(),
+                fins: Vec::new(),
                 seed,
             },
         )
