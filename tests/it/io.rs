@@ -638,6 +638,94 @@ fn bad_input_degenerate_duplicate_non_manifold() {
     );
 }
 
+/// `two_squares_41_ascii.msh` with the header of its second surface's triangle block
+/// (`2 2 2 22`: dimension, entity, type, count) replaced, written to `dir`; and the line.
+fn two_squares_with_block_header(dir: &Path, header: &str) -> (PathBuf, usize) {
+    let text = std::fs::read_to_string(data("two_squares_41_ascii.msh")).unwrap();
+    let line = 1 + text.lines().position(|l| l == "2 2 2 22").unwrap();
+    let p = dir.join("edited.msh");
+    std::fs::write(
+        &p,
+        text.replacen("\n2 2 2 22\n", &format!("\n{header}\n"), 1),
+    )
+    .unwrap();
+    (p, line)
+}
+
+/// Triangles in a block on a curve: Gmsh refuses the file ("Trying to add unsupported
+/// element in curve 2"), and which surface they were meant for is unknown.
+#[test]
+fn bad_input_element_block_on_an_entity_of_another_dimension() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, line) = two_squares_with_block_header(dir.path(), "1 2 2 22");
+    assert_bad(
+        &p,
+        &[
+            &format!(":{line}:"),
+            "element block 15",
+            "Triangle 3 elements (type 2, dimension 2)",
+            "entity of dimension 1 (tag 2)",
+        ],
+    );
+    // A node block's dimension out of range names its header's line too.
+    let text = std::fs::read_to_string(data("two_squares_41_ascii.msh")).unwrap();
+    let line = 1 + text.lines().position(|l| l == "2 2 0 6").unwrap();
+    let p = dir.path().join("nodes.msh");
+    std::fs::write(&p, text.replacen("\n2 2 0 6\n", "\n5 2 0 6\n", 1)).unwrap();
+    assert_bad(
+        &p,
+        &[
+            &format!(":{line}:"),
+            "node block",
+            "dimension 5 (expected 0 to 3)",
+        ],
+    );
+}
+
+/// Triangles on a surface that neither `$Entities` nor a `$Nodes` block declares (what
+/// meshio writes for `gmsh:geometrical` tags without `$Entities`; Gmsh refuses the file:
+/// "Unknown entity 7 of dimension 2") are read on that surface, and the output declares it,
+/// so Gmsh reads our file.
+#[test]
+fn element_block_on_an_undeclared_surface_is_read_and_declared() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, _) = two_squares_with_block_header(dir.path(), "2 7 2 22");
+    let m = msh::read(&p).unwrap();
+    m.sanity_check().unwrap();
+    assert_eq!(read("two_squares_41_ascii.msh").surfaces(), [1, 2]);
+    assert_eq!(m.surfaces(), [1, 7]);
+    let out = run_in(
+        dir.path(),
+        &[
+            "recombine",
+            "edited.msh",
+            "--algo",
+            "greedy",
+            "-o",
+            "out.msh",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    if gmsh_available() {
+        let script = r#"
+import sys, gmsh
+gmsh.initialize(["-noenv"])
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.open(sys.argv[1])
+print(sorted(t for _, t in gmsh.model.getEntities(2)))
+gmsh.finalize()
+"#;
+        assert_eq!(
+            python(script, &[&dir.path().join("out.msh")]).trim(),
+            "[1, 2, 7]"
+        );
+    }
+}
+
 #[test]
 fn bad_input_non_orientable() {
     assert_bad(&bad("moebius.msh"), &["not orientable"]);

@@ -152,6 +152,15 @@ fn header41(p: &mut Parser<'_>, s: &str, item: &str) -> Res<(usize, u64, u64)> {
     Ok((hp, blocks, total))
 }
 
+/// Where a block header starts: in ASCII its first value (past the line end before it, so
+/// that an error there names the header's line), in binary the next byte.
+fn header_start(p: &mut Parser<'_>) -> usize {
+    if !p.binary {
+        p.skip_ws();
+    }
+    p.pos
+}
+
 /// The `$Nodes` section of MSH 4.1, in either encoding: the headers read alike, the
 /// blocks' tags and coordinates per encoding.
 pub(super) fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
@@ -164,7 +173,7 @@ pub(super) fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     c.model.node_entity.reserve(cap(total, min_bytes, left));
     for blk in 0..blocks {
         let what_blk = || format!("the header of node block {} of {blocks}", blk + 1);
-        let dp = p.pos;
+        let dp = header_start(p);
         let dim = p.int_field(s, &what_blk)?;
         p.entry_start();
         let ep = p.pos;
@@ -316,6 +325,7 @@ pub(super) fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> 
     let mut seen = 0u64;
     for blk in 0..blocks {
         let what_blk = || format!("the header of element block {} of {blocks}", blk + 1);
+        let dp = header_start(p);
         let entity_dim = p.int_field(s, &what_blk)?;
         p.entry_start();
         let ep = p.pos;
@@ -341,6 +351,17 @@ pub(super) fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> 
                 unknown_type(&format!("element block {}", blk + 1), etype),
             ));
         };
+        // Gmsh refuses elements on an entity of another dimension ("Trying to add
+        // unsupported element in curve 2"): which entity they were meant for is unknown.
+        if entity_dim != i64::from(dim) {
+            return Err(p.err(
+                dp,
+                format!(
+                    "element block {} holds {name} elements (type {etype}, dimension {dim}) but is on an entity of dimension {entity_dim} (tag {entity}); Gmsh refuses such a block",
+                    blk + 1
+                ),
+            ));
+        }
         let block = Block41 {
             index: blk,
             len: n,
