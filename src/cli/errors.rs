@@ -9,7 +9,7 @@
 //! | 3 | bad input: a mesh file unreadable or invalid, a results directory whose files are corrupt or do not form one sweep |
 //! | 4 | the results directory cannot be used: it holds other runs or another configuration, another sweep is writing it, or it is not a directory or lies under a file |
 //! | 5 | out of memory ([`super::oom`]) |
-//! | 130 | interrupted (Ctrl-C) |
+//! | 130 | interrupted (Ctrl-C, SIGTERM or SIGHUP) |
 
 use std::error::Error;
 

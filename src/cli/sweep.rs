@@ -308,14 +308,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ProgressMode::Auto
     });
 
+    // Ctrl-C, SIGTERM (a batch scheduler's stop, `kill`) and SIGHUP (the terminal closed)
+    // stop alike: ctrlc's `termination` feature.
     ctrlc::set_handler(|| {
         if CANCEL.swap(true, Ordering::SeqCst) {
             noteln!("\nsweep: interrupted again, exiting now (finished runs are saved)");
             std::process::exit(i32::from(EXIT_INTERRUPTED));
         }
-        noteln!("\nsweep: interrupted: finishing the runs in flight (Ctrl-C again to quit now)");
+        noteln!("\nsweep: interrupted: finishing the runs in flight (Ctrl-C or SIGTERM again to quit now)");
     })
-    .context("installing the Ctrl-C handler")?;
+    .context("installing the Ctrl-C / SIGTERM handler")?;
 
     // The searches' wall time: from the engine's start of the runs to their end.
     let (mut runs_start, mut runs_end) = (None, None);

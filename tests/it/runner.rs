@@ -305,6 +305,20 @@ fn overwrite_replaces_an_earlier_sweep_with_another_configuration() {
 
 #[test]
 fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
+    interrupted_sweep_keeps_its_runs("-INT");
+}
+
+/// SIGTERM (`kill`, a batch scheduler's stop) stops a sweep as Ctrl-C does: the runs in
+/// flight finish, no line is torn, exit 130 (the default action killed it mid-write).
+#[test]
+fn sigterm_stops_a_sweep_as_ctrl_c_does() {
+    interrupted_sweep_keeps_its_runs("-TERM");
+}
+
+/// A sweep sent `signal` (a `kill` option) once it has recorded ten runs: a second sweep into
+/// its directory meanwhile is refused; it exits 130, keeps every finished run without a torn
+/// line, and `--resume` completes it.
+fn interrupted_sweep_keeps_its_runs(signal: &str) {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let mesh = small_mesh(dir, 1000);
@@ -328,7 +342,7 @@ fn ctrl_c_saves_finished_runs_and_exits_non_zero() {
         stderr(&second)
     );
     let kill = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([signal, &child.id().to_string()])
         .status()
         .unwrap();
     assert!(kill.success());
