@@ -75,6 +75,13 @@ pub enum ReadError {
         hint = conversion_hint(.path)
     )]
     UnknownFormat { path: PathBuf, builtins: String },
+    /// A compressed file, told by its first bytes ([`ReadError::unknown_format`]).
+    #[error("{path}: the file is {what}: decompress it first (`{command}`) and give that file")]
+    Compressed {
+        path: PathBuf,
+        what: &'static str,
+        command: String,
+    },
     #[error("{path}:{line}: {message}")]
     Syntax {
         path: PathBuf,
@@ -86,6 +93,48 @@ pub enum ReadError {
     /// `suite:NAME` with a name the suite does not have.
     #[error("no suite mesh is named {name:?} (suite meshes: {names})")]
     UnknownSuiteMember { name: String, names: String },
+}
+
+impl ReadError {
+    /// The error for `path`, whose first bytes `head` are no mesh quadrecomb reads: a
+    /// compressed file (gzip, bzip2, xz, zstd, zip) gets the command that decompresses it,
+    /// anything else [`ReadError::UnknownFormat`] with the conversion commands (Gmsh, given
+    /// a gzip file, asks to uncompress it first).
+    pub(crate) fn unknown_format(path: &std::path::Path, head: &[u8]) -> ReadError {
+        const KINDS: [(&[u8], &str, &str); 5] = [
+            (b"\x1f\x8b", "gzip-compressed", "gzip -dc"),
+            (b"BZh", "bzip2-compressed", "bzip2 -dc"),
+            (b"\xfd7zXZ\x00", "xz-compressed", "xz -dc"),
+            (b"\x28\xb5\x2f\xfd", "zstd-compressed", "zstd -dc"),
+            (b"PK\x03\x04", "a zip archive", "unzip -p"),
+        ];
+        let Some(&(_, what, tool)) = KINDS.iter().find(|k| head.starts_with(k.0)) else {
+            return ReadError::UnknownFormat {
+                path: path.to_path_buf(),
+                builtins: super::builtin::NAMES.join(", "),
+            };
+        };
+        // The name without its compression suffix, ending in .msh.
+        let compressed = ["gz", "bz2", "xz", "zst", "zip"];
+        let mut out = path.to_path_buf();
+        if out
+            .extension()
+            .is_some_and(|e| compressed.iter().any(|c| e.eq_ignore_ascii_case(c)))
+        {
+            out.set_extension("");
+        }
+        if !out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("msh"))
+        {
+            out.as_mut_os_string().push(".msh");
+        }
+        ReadError::Compressed {
+            path: path.to_path_buf(),
+            what,
+            command: format!("{tool} {} > {}", path.display(), out.display()),
+        }
+    }
 }
 
 /// Why a triangle of relative height `10^lg` is degenerate, in words.

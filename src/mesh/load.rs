@@ -114,10 +114,7 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>, ReadError> {
     if let Some(start) = head.iter().position(|c| !c.is_ascii_whitespace()) {
         let known = head.len() - start >= b"$MeshFormat".len() || eof;
         if known && !msh::is_msh(head) {
-            return Err(ReadError::UnknownFormat {
-                path: path.to_path_buf(),
-                builtins: builtin::NAMES.join(", "),
-            });
+            return Err(ReadError::unknown_format(path, &bytes));
         }
     }
     // Exactly the file's size: `read_to_end` doubles its buffer as it goes, which left the

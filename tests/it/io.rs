@@ -638,6 +638,47 @@ fn bad_input_degenerate_duplicate_non_manifold() {
     );
 }
 
+/// A compressed mesh is told by its first bytes, and the command the message gives makes a
+/// file that reads.
+#[test]
+fn compressed_input_names_the_command_that_decompresses_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let gz = dir.path().join("two.msh.gz");
+    let zipped = Command::new("gzip")
+        .arg("-c")
+        .arg(data("two_squares_41_ascii.msh"))
+        .output()
+        .expect("gzip");
+    std::fs::write(&gz, zipped.stdout).unwrap();
+    let err = assert_bad(&gz, &["gzip-compressed", "`gzip -dc "]);
+    assert!(!err.contains("convert it"), "{err}");
+    let command = err.split('`').nth(1).unwrap();
+    assert!(command.contains("two.msh.gz > "), "{command}");
+    let done = Command::new("sh")
+        .args(["-c", command])
+        .current_dir(dir.path())
+        .status()
+        .unwrap();
+    assert!(done.success(), "{command}");
+    let out = command.rsplit("> ").next().unwrap();
+    assert!(out.ends_with("two.msh"), "{out}");
+    assert_eq!(
+        msh::read(&dir.path().join(out)).unwrap().num_triangles(),
+        read("two_squares_41_ascii.msh").num_triangles()
+    );
+    // Other compressors by their magic bytes.
+    for (magic, what) in [
+        (&b"BZh91AY&SY"[..], "bzip2-compressed"),
+        (b"\xfd7zXZ\x00\x00", "xz-compressed"),
+        (b"\x28\xb5\x2f\xfd\x00", "zstd-compressed"),
+        (b"PK\x03\x04\x14\x00", "a zip archive"),
+    ] {
+        let p = dir.path().join("mesh.bin");
+        std::fs::write(&p, magic).unwrap();
+        assert_bad(&p, &[what, "mesh.bin > "]);
+    }
+}
+
 /// `two_squares_41_ascii.msh` with the header of its second surface's triangle block
 /// (`2 2 2 22`: dimension, entity, type, count) replaced, written to `dir`; and the line.
 fn two_squares_with_block_header(dir: &Path, header: &str) -> (PathBuf, usize) {

@@ -48,10 +48,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
         });
     }
     if !looks_like_msh(bytes) {
-        return Err(ReadError::UnknownFormat {
-            path: path.to_path_buf(),
-            builtins: crate::mesh::builtin::NAMES.join(", "),
-        });
+        return Err(ReadError::unknown_format(path, bytes));
     }
     let mut p = Parser {
         path,
