@@ -2,6 +2,7 @@
 //! which rule, on which machine and with which seeds.
 
 use super::{Document, Results, Run};
+use crate::experiment::plan;
 
 /// Opening paragraph: what was run, where, by which version.
 pub(super) fn overview(doc: &mut Document, results: &Results) {
@@ -20,6 +21,22 @@ pub(super) fn overview(doc: &mut Document, results: &Results) {
         versions.join(", "),
         backends.join(", "),
     ));
+    if let Some(m) = &results.manifest {
+        // The runs this directory's manifest plans (its shard's, for a shard).
+        let planned = plan::shard(plan::plan(&m.spec), m.shard).len();
+        let recorded = results.num_runs();
+        if recorded < planned {
+            doc.para(format!(
+                "Incomplete sweep: {recorded} of the {planned} runs planned {} are recorded (it \
+                 was interrupted, or is still running). Run the same quadrecomb sweep command \
+                 with --resume to finish it. The medians, tests and figures below are over the \
+                 recorded runs, so configurations may hold fewer runs than planned and \
+                 different numbers of them.",
+                m.shard
+                    .map_or("in this directory".to_string(), |s| format!("in shard {s}")),
+            ));
+        }
+    }
     let mut rules: Vec<String> = runs.iter().map(|r| r.rule().to_string()).collect();
     rules.sort_unstable();
     rules.dedup();

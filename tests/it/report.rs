@@ -649,6 +649,58 @@ fn compare_two_directories() {
     );
 }
 
+/// A report of a sweep that was stopped says so: how many of the planned runs it holds
+/// and how to finish; a finished sweep's report does not.
+#[test]
+fn report_of_an_unfinished_sweep_says_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let ok = |args: &[&str]| {
+        let out = run_in(dir, args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    ok(&["generate", "grid", "--triangles", "300", "-o", "g.msh"]);
+    ok(&[
+        "sweep",
+        "--mesh",
+        "g.msh",
+        "--algo",
+        "greedy",
+        "--algo",
+        "selective",
+        "--horizons",
+        "1,2",
+        "--runs",
+        "4",
+        "--out",
+        "s",
+        "--quiet",
+        "--no-report",
+    ]);
+    let report_md = || {
+        ok(&["report", "s", "--no-pictures"]);
+        std::fs::read_to_string(dir.join("s/report.md")).unwrap()
+    };
+    let md = report_md();
+    assert!(md.contains("9 runs in 3 configurations"), "{md}");
+    assert!(!md.contains("Incomplete"), "{md}");
+    // Keep the first five records, as an interrupted sweep leaves them.
+    let runs = dir.join("s/runs.jsonl");
+    let text = std::fs::read_to_string(&runs).unwrap();
+    let kept: Vec<&str> = text.lines().take(5).collect();
+    std::fs::write(&runs, kept.join("\n") + "\n").unwrap();
+    let md = report_md();
+    assert!(
+        md.contains("Incomplete sweep: 5 of the 9 runs planned in this directory are recorded"),
+        "{md}"
+    );
+    assert!(md.contains("with --resume"), "{md}");
+}
+
 #[test]
 fn torn_last_line_is_skipped_and_other_bad_lines_are_errors() {
     let tmp = tempfile::tempdir().unwrap();
