@@ -43,14 +43,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(Err(e)) => anyhow::bail!("certificate check failed: {e}"),
         None => None,
     };
-    if let Some(path) = &args.out.output {
+    // A failed write is reported after the figures, which are printed all the same.
+    let written = args.out.output.as_ref().map(|path| {
         super::write_mesh_output(
             path,
             &mesh,
             &quality::recombined(&mesh, &table, &opt.chosen),
             args.out.vtu_ascii,
-        )?;
-    }
+        )
+    });
     if args.json {
         let mut v = serde_json::json!({
             "mesh": args.mesh,
@@ -93,9 +94,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 r.positive_blossoms
             );
         }
-        if let Some(p) = &args.out.output {
+        if let (Some(p), Some(Ok(()))) = (&args.out.output, &written) {
             outln!("wrote           {}", p.display());
         }
     }
+    written.transpose()?;
     Ok(ExitCode::SUCCESS)
 }

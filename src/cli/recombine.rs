@@ -259,19 +259,19 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .as_ref()
         .filter(|o| o.quality > 0.0)
         .map(|o| 100.0 * out.quality / o.quality);
-    if let Some(path) = &args.out.output {
-        match &finished {
-            Some(f) => {
-                let (m, t) = (f.mesh(&mesh), f.table(&table));
-                let rec = quality::recombined(m, t, &f.chosen);
-                super::write_mesh_output(path, m, &rec, args.out.vtu_ascii)?;
-            }
-            None => {
-                let rec = quality::recombined(&mesh, &table, &out.chosen);
-                super::write_mesh_output(path, &mesh, &rec, args.out.vtu_ascii)?;
-            }
+    // A failed write is reported after the run's figures, which are printed all the same:
+    // the work is not lost with the file.
+    let written = args.out.output.as_ref().map(|path| match &finished {
+        Some(f) => {
+            let (m, t) = (f.mesh(&mesh), f.table(&table));
+            let rec = quality::recombined(m, t, &f.chosen);
+            super::write_mesh_output(path, m, &rec, args.out.vtu_ascii)
         }
-    }
+        None => {
+            let rec = quality::recombined(&mesh, &table, &out.chosen);
+            super::write_mesh_output(path, &mesh, &rec, args.out.vtu_ascii)
+        }
+    });
     let pct_of = |q: f64| {
         opt.as_ref()
             .filter(|o| o.quality > 0.0)
@@ -348,9 +348,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         if let Some(f) = &finished {
             super::finish_report::print(f, &table, pct_of);
         }
-        if let Some(p) = &args.out.output {
+        if let (Some(p), Some(Ok(()))) = (&args.out.output, &written) {
             outln!("wrote           {}", p.display());
         }
     }
+    written.transpose()?;
     Ok(ExitCode::SUCCESS)
 }

@@ -186,22 +186,40 @@ fn a_users_own_report_and_summary_are_not_written_over() {
 }
 
 /// Writing `-o` failing after the work (here a file-size limit, as a full disk) is a failure
-/// of the system, exit 1, not a usage error (exit 2, as it was), and leaves no file.
+/// of the system, exit 1, not a usage error (exit 2, as it was), and leaves no file; the
+/// run's figures are printed all the same (text and `--json`), without a "wrote" line.
 #[test]
 fn a_failed_write_after_the_work_exits_1() {
-    let tmp = tempfile::tempdir().unwrap();
-    let o = std::process::Command::new("sh")
-        .arg("-c")
-        .arg("trap '' XFSZ; ulimit -f 1; exec \"$0\" recombine sphere --algo greedy -o out.msh")
-        .arg(crate::util::bin())
-        .current_dir(tmp.path())
-        .output()
-        .unwrap();
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("cannot write output out.msh"), "{err}");
-    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
-    assert!(left.is_empty(), "{left:?}");
+    for (cmd, json) in [
+        ("recombine sphere --algo greedy", false),
+        ("recombine sphere --algo greedy", true),
+        ("optimum sphere", false),
+        ("optimum sphere", true),
+    ] {
+        let tmp = tempfile::tempdir().unwrap();
+        let flag = if json { " --json" } else { "" };
+        let o = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "trap '' XFSZ; ulimit -f 1; exec \"$0\" {cmd}{flag} -o out.msh"
+            ))
+            .arg(crate::util::bin())
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        let (err, out) = (stderr(&o), String::from_utf8_lossy(&o.stdout));
+        assert_eq!(o.status.code(), Some(1), "{cmd}{flag}: {err}");
+        assert!(err.contains("cannot write output out.msh"), "{err}");
+        let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+        assert!(left.is_empty(), "{left:?}");
+        if json {
+            let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+            assert!(v["quads"].as_u64().unwrap() > 800, "{cmd}: {out}");
+        } else {
+            assert!(out.contains("quality "), "{cmd}: {out}");
+            assert!(!out.contains("wrote"), "{cmd}: {out}");
+        }
+    }
 }
 
 /// The library's notices reach stderr through the command: the backend `--backend auto` picked, once,
