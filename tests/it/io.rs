@@ -723,14 +723,33 @@ fn bad_input_element_block_on_an_entity_of_another_dimension() {
     );
 }
 
-/// Triangles on a surface that neither `$Entities` nor a `$Nodes` block declares (what
-/// meshio writes for `gmsh:geometrical` tags without `$Entities`; Gmsh refuses the file:
-/// "Unknown entity 7 of dimension 2") are read on that surface, and the output declares it,
-/// so Gmsh reads our file.
+/// Triangles on a surface that neither `$Entities` nor a `$Nodes` block declares: refused as
+/// Gmsh refuses them ("Unknown entity 7 of dimension 2"), naming the block's line; declared
+/// by a node block, they are read, as Gmsh reads them. Without `$Entities` (meshio writes
+/// such files for `gmsh:geometrical` tags; Gmsh refuses them) they are read on that surface,
+/// and the output declares it, so Gmsh reads our file.
 #[test]
-fn element_block_on_an_undeclared_surface_is_read_and_declared() {
+fn element_block_on_an_undeclared_surface() {
     let dir = tempfile::tempdir().unwrap();
-    let (p, _) = two_squares_with_block_header(dir.path(), "2 7 2 22");
+    let (p, line) = two_squares_with_block_header(dir.path(), "2 7 2 22");
+    assert_bad(
+        &p,
+        &[
+            &format!(":{line}:"),
+            "element block 15 is on surface 7, which neither $Entities nor a $Nodes block declares",
+        ],
+    );
+    let text = std::fs::read_to_string(&p).unwrap();
+    // The same with the surface's node block on surface 7: Gmsh makes the entity.
+    std::fs::write(&p, text.replacen("\n2 2 0 6\n", "\n2 7 0 6\n", 1)).unwrap();
+    assert_eq!(msh::read(&p).unwrap().surfaces(), [1, 7]);
+    // Without $Entities.
+    let (a, b) = (
+        text.find("$Entities").unwrap(),
+        text.find("$EndEntities\n").unwrap(),
+    );
+    let text = format!("{}{}", &text[..a], &text[b + "$EndEntities\n".len()..]);
+    std::fs::write(&p, text).unwrap();
     let m = msh::read(&p).unwrap();
     m.sanity_check().unwrap();
     assert_eq!(read("two_squares_41_ascii.msh").surfaces(), [1, 2]);

@@ -63,6 +63,9 @@ pub(super) struct Content {
     /// interfaces between volume partitions. Their triangles lie inside the volume, not on
     /// a model surface, and are skipped.
     pub(super) interfaces: HashSet<i64>,
+    /// MSH 4.1: the entities of the `$Nodes` blocks (Gmsh makes an entity a block names if
+    /// `$Entities` does not declare it; an element block's entity must be declared one way).
+    pub(super) node_block_entities: HashSet<(u8, i32)>,
     /// The model, as the file gives it (see [`ModelParts::finish`]).
     pub(super) model: ModelParts,
 }
@@ -214,6 +217,7 @@ impl Content {
             skipped: BTreeMap::new(),
             parents: HashMap::new(),
             interfaces: HashSet::new(),
+            node_block_entities: HashSet::new(),
             model: ModelParts::default(),
         }
     }

@@ -212,6 +212,7 @@ pub(super) fn nodes41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
                 ));
             }
         };
+        c.node_block_entities.insert(entity);
         let block = NodeBlock41 {
             index: blk,
             len: n,
@@ -372,6 +373,26 @@ pub(super) fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> 
             on_interface: entity_dim == 2 && c.interfaces.contains(&entity),
         };
         if block.keep() || block.lower() {
+            // With `$Entities`, the entity must be declared there, in `$PartitionedEntities`
+            // or by a `$Nodes` block, as Gmsh requires ("Unknown entity 7 of dimension 2"):
+            // else which entity, and which physical groups, the elements were meant for is
+            // unknown. Without `$Entities` (meshio writes such files) the entity is made.
+            let key = (dim, surface);
+            let declared = |e: &[Entity]| e.iter().any(|e| (e.dim, e.tag) == key);
+            if let Some(entities) = &c.model.entities
+                && !declared(entities)
+                && !c.model.parents.contains_key(&key)
+                && !c.node_block_entities.contains(&key)
+            {
+                let kind = ["point", "curve", "surface"][usize::from(dim.min(2))];
+                return Err(p.err(
+                    ep,
+                    format!(
+                        "element block {} is on {kind} {surface}, which neither $Entities nor a $Nodes block declares; Gmsh refuses such a file (\"Unknown entity {surface} of dimension {dim}\")",
+                        blk + 1
+                    ),
+                ));
+            }
             c.model.on_entity(dim, surface, 0);
         }
         if p.binary {
