@@ -75,7 +75,7 @@ pub enum ReadError {
         hint = conversion_hint(.path)
     )]
     UnknownFormat { path: PathBuf, builtins: String },
-    /// A compressed file, told by its first bytes ([`ReadError::unknown_format`]).
+    /// A compressed file, told by its first bytes (gzip, bzip2, xz, zstd, zip).
     #[error("{path}: the file is {what}: decompress it first (`{command}`) and give that file")]
     Compressed {
         path: PathBuf,
