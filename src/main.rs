@@ -12,6 +12,7 @@ static ALLOC: cli::oom::ExitOnOom = cli::oom::ExitOnOom;
 
 fn main() -> ExitCode {
     quiet_mesa_device_select();
+    ignore_file_size_signal();
     match cli::run() {
         Ok(code) => code,
         Err(err) => {
@@ -21,6 +22,20 @@ fn main() -> ExitCode {
         }
     }
 }
+
+/// A file-size limit (`ulimit -f`) makes the kernel send SIGXFSZ to a write past it, whose
+/// default action kills the process (exit 153) before the write's error is reported, leaving
+/// its temporary file behind and the run's figures unprinted. Ignored, such a write fails
+/// with EFBIG as on a full disk, and the error path removes the temporary file and reports.
+#[cfg(unix)]
+#[allow(unsafe_code)]
+fn ignore_file_size_signal() {
+    // SAFETY: SIG_IGN installs no handler code to run; done before any thread exists.
+    unsafe { libc::signal(libc::SIGXFSZ, libc::SIG_IGN) };
+}
+
+#[cfg(not(unix))]
+fn ignore_file_size_signal() {}
 
 /// Mesa's device-selection layer (an implicit Vulkan layer installed with lavapipe) prints
 /// `error: XDG_RUNTIME_DIR is invalid or not set in the environment.` on every instance it

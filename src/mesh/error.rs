@@ -114,7 +114,8 @@ impl ReadError {
                 builtins: super::builtin::NAMES.join(", "),
             };
         };
-        // The name without its compression suffix, ending in .msh.
+        // The name without its compression suffix, ending in .msh, and never the input's
+        // own name (the shell would empty the input before the tool reads it).
         let compressed = ["gz", "bz2", "xz", "zst", "zip"];
         let mut out = path.to_path_buf();
         if out
@@ -129,11 +130,30 @@ impl ReadError {
         {
             out.as_mut_os_string().push(".msh");
         }
+        if out == path {
+            out.set_extension("decompressed.msh");
+        }
         ReadError::Compressed {
             path: path.to_path_buf(),
             what,
-            command: format!("{tool} {} > {}", path.display(), out.display()),
+            command: format!("{tool} {} > {}", shell_word(path), shell_word(&out)),
         }
+    }
+}
+
+/// `path` as one word a POSIX shell reads back unchanged, and never as an option: quoted
+/// (`'...'`, a `'` inside as `'\''`) unless it holds only characters no shell treats
+/// specially, and prefixed with `./` when it begins with `-`.
+fn shell_word(path: &std::path::Path) -> String {
+    let mut s = path.to_string_lossy().into_owned();
+    if s.starts_with('-') {
+        s.insert_str(0, "./");
+    }
+    let plain = |c: char| c.is_ascii_alphanumeric() || "._/-+,:@%=".contains(c);
+    if !s.is_empty() && s.chars().all(plain) {
+        s
+    } else {
+        format!("'{}'", s.replace('\'', "'\\''"))
     }
 }
 

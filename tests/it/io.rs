@@ -643,29 +643,49 @@ fn bad_input_degenerate_duplicate_non_manifold() {
 #[test]
 fn compressed_input_names_the_command_that_decompresses_it() {
     let dir = tempfile::tempdir().unwrap();
-    let gz = dir.path().join("two.msh.gz");
     let zipped = Command::new("gzip")
         .arg("-c")
         .arg(data("two_squares_41_ascii.msh"))
         .output()
-        .expect("gzip");
-    std::fs::write(&gz, zipped.stdout).unwrap();
-    let err = assert_bad(&gz, &["gzip-compressed", "`gzip -dc "]);
-    assert!(!err.contains("convert it"), "{err}");
-    let command = err.split('`').nth(1).unwrap();
-    assert!(command.contains("two.msh.gz > "), "{command}");
-    let done = Command::new("sh")
-        .args(["-c", command])
-        .current_dir(dir.path())
-        .status()
-        .unwrap();
-    assert!(done.success(), "{command}");
-    let out = command.rsplit("> ").next().unwrap();
-    assert!(out.ends_with("two.msh"), "{out}");
-    assert_eq!(
-        msh::read(&dir.path().join(out)).unwrap().num_triangles(),
-        read("two_squares_41_ascii.msh").num_triangles()
-    );
+        .expect("gzip")
+        .stdout;
+    // Gzipped meshes named `name`, given to `info` as relative names: the command the
+    // message gives, run by sh, leaves the input as it was and writes `want`, which reads.
+    for (name, want) in [
+        ("two.msh.gz", "two.msh"),
+        // Named as its output would be: another name, or the shell empties the input.
+        ("m.msh", "m.decompressed.msh"),
+        // Spaces, a quote and a leading dash: quoted, and not read as an option.
+        ("-it's a mesh.MSH.GZ", "-it's a mesh.MSH"),
+    ] {
+        let p = dir.path().join(name);
+        std::fs::write(&p, &zipped).unwrap();
+        let out = run_in(dir.path(), &["info", "--", name]);
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert_eq!(out.status.code(), Some(3), "{err}");
+        assert!(
+            err.contains("gzip-compressed") && err.contains("`gzip -dc "),
+            "{err}"
+        );
+        assert!(!err.contains("convert it"), "{err}");
+        let command = err.split('`').nth(1).unwrap();
+        let done = Command::new("sh")
+            .args(["-c", command])
+            .current_dir(dir.path())
+            .status()
+            .unwrap();
+        assert!(done.success(), "{command}");
+        assert_eq!(
+            std::fs::read(&p).unwrap(),
+            zipped,
+            "{command} changed {name}"
+        );
+        assert_eq!(
+            msh::read(&dir.path().join(want)).unwrap().num_triangles(),
+            read("two_squares_41_ascii.msh").num_triangles(),
+            "{command}"
+        );
+    }
     // Other compressors by their magic bytes.
     for (magic, what) in [
         (&b"BZh91AY&SY"[..], "bzip2-compressed"),
@@ -739,6 +759,11 @@ fn element_block_on_an_undeclared_surface() {
             "element block 15 is on surface 7, which neither $Entities nor a $Nodes block declares",
         ],
     );
+    let (negative, _) = two_squares_with_block_header(dir.path(), "2 -3 2 22");
+    let bad = dir.path().join("negative.msh");
+    std::fs::rename(&negative, &bad).unwrap();
+    assert_bad(&bad, &["element block 15 is on surface -3, which neither"]);
+    let (p, _) = two_squares_with_block_header(dir.path(), "2 7 2 22");
     let text = std::fs::read_to_string(&p).unwrap();
     // The same with the surface's node block on surface 7: Gmsh makes the entity.
     std::fs::write(&p, text.replacen("\n2 2 0 6\n", "\n2 7 0 6\n", 1)).unwrap();
