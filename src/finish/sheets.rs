@@ -6,10 +6,12 @@
 //! reaches a mesh boundary side (the node lies on the chord) or a side of another leftover. A
 //! quad crossed by two sheets becomes 4 quads around the crossing of its two midlines (their
 //! common midpoint, the mean of the four midpoints). Sides between surfaces are crossed like
-//! any inner side, so the result conforms. Each new quad is written as two triangles (the
-//! shorter diagonal) paired, so the result is a triangle mesh and a perfect pairing: the
-//! existing model. A sheet from a side is deterministic and reversible: it visits each quad
-//! side at most once.
+//! any inner side, so the result conforms; where three or more elements share a side
+//! (surfaces meeting), the sheet goes on across each of them. Each new quad is written as
+//! two triangles (the shorter diagonal) paired, so the result is a triangle mesh and a perfect
+//! pairing: the existing model. A sheet through sides of two elements is deterministic and
+//! reversible; one that branches where surfaces meet can come back to a side it gave a
+//! midpoint, which is not crossed again, so every side is crossed at most once.
 
 use super::region::Pairing;
 use crate::mesh::{Mesh, MeshData, MeshError, NONE};
@@ -116,6 +118,15 @@ pub(crate) fn refine(
     let first_vertex = mesh.vertices.len() as u32;
     let mut cut = vec![false; table.len()];
     let mut side_done = vec![[false; 3]; nt];
+    // Sides of input quads: a sheet cannot cross them (the quad is never split).
+    let quad_sides: std::collections::HashSet<[u32; 2]> = mesh
+        .quads
+        .iter()
+        .flat_map(|q| (0..4).map(move |i| key(q[i], q[(i + 1) % 4])))
+        .collect();
+    // The sides still to trace across, each with the element the sheet reaches it from.
+    let mut todo: Vec<(u32, u32, u32)> = Vec::new();
+    let mut steps = 0usize;
     for &t in &leftovers {
         for j in 0..3 {
             if side_done[t as usize][j] {
@@ -124,54 +135,64 @@ pub(crate) fn refine(
             side_done[t as usize][j] = true;
             stats.sheets += 1;
             let tri = mesh.triangles[t as usize];
-            let (mut cur, mut a, mut b) = (t, tri[j], tri[(j + 1) % 3]);
-            let mut steps = 0usize;
-            loop {
-                if let std::collections::hash_map::Entry::Vacant(v) = mids.entry(key(a, b)) {
-                    v.insert(first_vertex + mid_order.len() as u32);
-                    mid_order.push((key(a, b), mesh.triangle_surface[cur as usize]));
+            todo.push((t, tri[j], tri[(j + 1) % 3]));
+            let mut first = true;
+            while let Some((cur, a, b)) = todo.pop() {
+                match mids.entry(key(a, b)) {
+                    std::collections::hash_map::Entry::Vacant(v) => {
+                        v.insert(first_vertex + mid_order.len() as u32);
+                        mid_order.push((key(a, b), mesh.triangle_surface[cur as usize]));
+                    }
+                    // Reached again (a sheet through a side shared by three or more
+                    // elements can come back to it): whoever gave it its midpoint went on
+                    // across every element on it.
+                    std::collections::hash_map::Entry::Occupied(_) if !first => continue,
+                    std::collections::hash_map::Entry::Occupied(_) => {}
+                }
+                first = false;
+                if quad_sides.contains(&key(a, b)) {
+                    return Err(blocked(cur, a, b, "is shared with an input quad"));
                 }
                 let ct = mesh.triangles[cur as usize];
                 let s = side_of(ct, a, b).expect("the sheet's side is a side of its triangle");
                 let e = topo.triangle_edges[cur as usize][s] as usize;
-                let others: Vec<u32> = on_edge[e].iter().copied().filter(|&u| u != cur).collect();
-                let x = match others.as_slice() {
-                    [] if is_boundary[e] => break,
-                    [] => return Err(blocked(cur, a, b, "is shared with an input quad")),
-                    [x] => *x,
-                    _ => return Err(blocked(cur, a, b, "is shared by more than two elements")),
-                };
-                if is_left[x as usize] {
-                    let sx = side_of(mesh.triangles[x as usize], a, b)
-                        .expect("a neighbour shares the side");
-                    side_done[x as usize][sx] = true;
-                    break;
+                // Every other triangle on the side (of this surface or another): two or more
+                // where surfaces meet, and the sheet goes on across each.
+                let others = on_edge[e].iter().copied().filter(|&u| u != cur);
+                for x in others {
+                    if is_left[x as usize] {
+                        let sx = side_of(mesh.triangles[x as usize], a, b)
+                            .expect("a neighbour shares the side");
+                        side_done[x as usize][sx] = true;
+                        continue;
+                    }
+                    let c = pairing.cand[x as usize];
+                    let y = table.other(c, x);
+                    let q = table.quads[c as usize];
+                    let i = (0..4)
+                        .find(|&i| key(q[i], q[(i + 1) % 4]) == key(a, b))
+                        .ok_or_else(|| {
+                            blocked(
+                                cur,
+                                a,
+                                b,
+                                "is the diagonal of a quad (the mesh is not a manifold there)",
+                            )
+                        })?;
+                    cut[c as usize] = true;
+                    let (na, nb) = (q[(i + 2) % 4], q[(i + 3) % 4]);
+                    let next = if side_of(mesh.triangles[x as usize], na, nb).is_some() {
+                        x
+                    } else {
+                        y
+                    };
+                    todo.push((next, na, nb));
+                    steps += 1;
+                    assert!(
+                        steps <= 3 * nt + 1,
+                        "sheets cross each quad side at most once"
+                    );
                 }
-                let c = pairing.cand[x as usize];
-                let y = table.other(c, x);
-                let q = table.quads[c as usize];
-                let i = (0..4)
-                    .find(|&i| key(q[i], q[(i + 1) % 4]) == key(a, b))
-                    .ok_or_else(|| {
-                        blocked(
-                            cur,
-                            a,
-                            b,
-                            "is the diagonal of a quad (the mesh is not a manifold there)",
-                        )
-                    })?;
-                cut[c as usize] = true;
-                (a, b) = (q[(i + 2) % 4], q[(i + 3) % 4]);
-                cur = if side_of(mesh.triangles[x as usize], a, b).is_some() {
-                    x
-                } else {
-                    y
-                };
-                steps += 1;
-                assert!(
-                    steps <= 2 * table.len() + 1,
-                    "a sheet visits each quad side at most once"
-                );
             }
         }
     }

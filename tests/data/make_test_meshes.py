@@ -151,3 +151,24 @@ clamped = [c for _, c in gmsh.model.getEntities(1)
 gmsh.model.addPhysicalGroup(1, clamped, name="clamped")
 write("stiffened_41_ascii.msh", 4.1, 0)
 gmsh.finalize()
+
+# The six faces of a unit box and a wall across it at x = 0.5, meshed as shells (the volumes
+# removed), with sizes drawn per corner (seeded): the wall meets four faces along lines where
+# three surfaces share every edge, and most surfaces hold an odd number of triangles, so
+# that all-quad needs sheets, which cross those lines (tests/it/all_quad.rs).
+start("box_wall")
+import random
+random.seed(1)
+occ = gmsh.model.occ
+box = occ.addBox(0, 0, 0, 1, 1, 1)
+wall = occ.addRectangle(0, 0, 0, 1, 1)
+occ.rotate([(2, wall)], 0, 0, 0, 0, 1, 0, -1.5707963267948966)
+occ.translate([(2, wall)], 0.5, 0, 0)
+occ.fragment([(3, box)], [(2, wall)])
+occ.synchronize()
+gmsh.model.removeEntities(gmsh.model.getEntities(3))
+for d, t in gmsh.model.getEntities(0):
+    gmsh.model.mesh.setSize([(d, t)], random.uniform(0.15, 0.4))
+gmsh.model.mesh.generate(2)
+write("box_wall_41_ascii.msh", 4.1, 0)
+gmsh.finalize()

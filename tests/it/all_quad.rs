@@ -5,7 +5,7 @@
 //! code, the exact optimum of each split mesh), and from the written files as meshio reads
 //! them (`all_quad_check.py`).
 
-use crate::util::{python, python_module_available, run_in};
+use crate::util::{python, python_module_available, repo_path, run_in};
 use quadrecomb::internals::finish::{
     FinishConfig, FinishError, Finished, SheetError, SheetStats, finish,
 };
@@ -434,6 +434,47 @@ fn all_quad_refines_a_lone_triangle_into_three_quads() {
 
 /// A sheet that reaches a side shared with an input quad cannot go on conformingly: a clear
 /// error naming the element and the side, nothing half made.
+/// Sheets cross edges where three surfaces meet (a box's faces and a wall across it, shells
+/// with odd surfaces that no split fixes, a Gmsh mesh): every surface on such an edge gets
+/// its midpoint, so the output conforms (checked by meshio: no hanging edge, every edge used
+/// by one, two, or as many elements as the input edge it lies on). Refused before, at the
+/// first such edge a sheet reached.
+#[test]
+fn cli_all_quad_sheets_cross_edges_where_three_surfaces_meet() {
+    if !python_module_available("meshio") {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let input = repo_path("tests/data/box_wall_41_ascii.msh");
+    let out = run_in(
+        tmp.path(),
+        &[
+            "recombine",
+            input.to_str().unwrap(),
+            "--algo",
+            "selective",
+            "--finish",
+            "--all-quad",
+            "--json",
+            "-o",
+            "out.msh",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["finish"]["sheets"]["sheets"].as_u64().unwrap() > 0, "{v}");
+    let script = include_str!("all_quad_check.py");
+    let text = python(script, &[input.as_path(), &tmp.path().join("out.msh")]);
+    let line = text.lines().find(|l| l.starts_with('{')).unwrap();
+    let c: serde_json::Value = serde_json::from_str(line).unwrap();
+    assert!(c["input_junction_edges"].as_u64().unwrap() > 10, "{c}");
+    check_written(&input, &tmp.path().join("out.msh"));
+}
+
 #[test]
 fn all_quad_sheet_stops_with_an_error_at_an_input_quad() {
     let mesh = Mesh::new(MeshData {

@@ -3,8 +3,8 @@
 # quad's Newell normal, all positive); every node not in the input lies strictly inside one
 # boundary side of the input (a side used by one input element) on its chord (with sheet
 # refinement: every new node on the output's boundary does, the others are inner); conformity:
-# every edge is used by one or two quads, and an edge used by one lies on an input boundary
-# side; the quads cover the input's area. Prints one JSON object.
+# every edge is used by one or two quads (or, where surfaces meet, by as many as the input
+# edge it lies on), and an edge used by one lies on an input boundary side; the quads cover the input's area. Prints one JSON object.
 # Usage: python3 all_quad_check.py INPUT.msh OUTPUT.(msh|vtu) [INPUT OUTPUT ...]: one line
 # per pair.
 import json
@@ -82,9 +82,27 @@ def check(inp, out):
                 ok = False
         nonconvex += not ok
 
-    # Conformity.
+    # Conformity. An edge may be used by more than two elements only where surfaces meet:
+    # along an input edge used by as many.
     use = edge_use(list(quads) + list(tri_out))
-    over = sum(1 for n in use.values() if n > 2)
+    junctions_in = [(k, n) for k, n in edge_use(list(tri_in) + list(quad_in)).items() if n > 2]
+
+
+    def on_input_junction(a, b, n):
+        for (u, v), m in junctions_in:
+            if m != n:
+                continue
+            s0, d = pin[u], pin[v] - pin[u]
+            ok = True
+            for x in (P[a], P[b]):
+                t = np.dot(x - s0, d) / np.dot(d, d)
+                ok &= bool(np.linalg.norm(x - (s0 + t * d)) <= tol and -1e-9 <= t <= 1 + 1e-9)
+            if ok:
+                return True
+        return False
+
+
+    over = sum(1 for (a, b), n in use.items() if n > 2 and not on_input_junction(a, b, n))
 
 
     def on_input_boundary(a, b):
@@ -128,6 +146,7 @@ def check(inp, out):
         "new_boundary_nodes_off_boundary_side": len(new_boundary_off),
         "nonconvex": nonconvex,
         "edges_over_two": over,
+        "input_junction_edges": len(junctions_in),
         "hanging_edges": hanging,
         "area_in": area_in,
         "area_out": area_out,
