@@ -5,7 +5,7 @@
 //! code, the exact optimum of each split mesh), and from the written files as meshio reads
 //! them (`all_quad_check.py`).
 
-use crate::util::{python, python_module_available, repo_path, run_in};
+use crate::util::{python, python_module_available, repo_path, run_in, run_ok};
 use quadrecomb::internals::finish::{
     FinishConfig, FinishError, Finished, SheetError, SheetStats, finish,
 };
@@ -446,25 +446,18 @@ fn cli_all_quad_sheets_cross_edges_where_three_surfaces_meet() {
     }
     let tmp = tempfile::tempdir().unwrap();
     let input = repo_path("tests/data/box_wall_41_ascii.msh");
-    let out = run_in(
-        tmp.path(),
-        &[
-            "recombine",
-            input.to_str().unwrap(),
-            "--algo",
-            "selective",
-            "--finish",
-            "--all-quad",
-            "--json",
-            "-o",
-            "out.msh",
-        ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let args = [
+        "--algo",
+        "selective",
+        "--finish",
+        "--all-quad",
+        "--json",
+        "-o",
+        "out.msh",
+    ];
+    let mut all = vec!["recombine", input.to_str().unwrap()];
+    all.extend(args);
+    let out = run_ok(tmp.path(), &all);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v["finish"]["sheets"]["sheets"].as_u64().unwrap() > 0, "{v}");
     let script = include_str!("all_quad_check.py");

@@ -2,7 +2,7 @@
 //! synthetic results (every configuration named, every SVG parsing and rendering with the
 //! expected boxes), mesh pictures, and the `report` subcommand.
 
-use crate::util::{SEED, run_in};
+use crate::util::{SEED, run_in, run_ok};
 use quadrecomb::internals::experiment::record::RunRecord;
 use quadrecomb::internals::mesh::{Mesh, MeshData};
 use quadrecomb::internals::quality::{CandidateTable, recombined};
@@ -656,12 +656,7 @@ fn report_of_an_unfinished_sweep_says_so() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let ok = |args: &[&str]| {
-        let out = run_in(dir, args);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        run_ok(dir, args);
     };
     ok(&["generate", "grid", "--triangles", "300", "-o", "g.msh"]);
     ok(&[

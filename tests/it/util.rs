@@ -25,6 +25,17 @@ pub fn run_in(dir: &Path, args: &[&str]) -> Output {
         .expect("run quadrecomb")
 }
 
+/// [`run_in`], asserting that the command succeeded (its stderr in the message).
+pub fn run_ok(dir: &Path, args: &[&str]) -> Output {
+    let out = run_in(dir, args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// Whether `python3` can import `gmsh` 4.15.2 (the version the test meshes and expected
 /// figures come from). Outside CI a test without it skips with a message; in CI (`CI` set)
 /// it must be there, so that no Gmsh check is skipped silently.
