@@ -235,7 +235,8 @@ fn parametric_coordinates_are_written_back() {
 /// run) too, and under --allow-invalid the signed area only: its quads with a corner of 180
 /// degrees or more fold when smoothed (absolute area 0.929 -> 1.147). And `recombine()`
 /// keeps the area: before the model was written, Gmsh's recombination of our borouchaki
-/// dropped elements (6 % of the area) and smoothing moved its boundary.
+/// dropped elements (6 % of the area) and smoothing moved its boundary. On a stiffened
+/// plate (surfaces meeting three at an edge) the nodes of the junction lines stay too.
 #[test]
 fn gmsh_smooths_and_recombines_our_output() {
     if !gmsh_available() {
@@ -260,7 +261,11 @@ gmsh.finalize()
     let c_input = data("channel_41_ascii.msh");
     let (b_all, _) = write_recombined(dir.path(), "b_all.msh", &borouchaki, Rule::AllPairs);
     let (b_valid, _) = write_recombined(dir.path(), "b_valid.msh", &borouchaki, Rule::default());
+    // A shell model: three surfaces meet along two lines, whose nodes must stay.
+    let (stiffened, s_input) = load("stiffened_41_ascii.msh");
+    let (s_ours, _) = write_recombined(dir.path(), "stiff.msh", &stiffened, Rule::default());
     for (what, path, input, absolute) in [
+        ("our stiffened plate", &s_ours, &s_input, true),
         ("Gmsh's channel", &gmsh_own, &c_input, true),
         ("our channel", &ours, &c_input, true),
         ("our borouchaki, --allow-invalid", &b_all, &b_input, false),
