@@ -36,6 +36,8 @@ struct Info {
     components: usize,
     odd_components: usize,
     boundary_edges: usize,
+    /// Edges of three or more elements: where surfaces meet (shell models).
+    junction_edges: usize,
     candidate_pairs: usize,
     /// Candidate pairs whose quad is strictly convex (eta > 0): the actions under the
     /// default rule.
@@ -127,6 +129,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 path: src.path.clone(),
                 source,
             })?;
+        let (boundary_edges, junction_edges) = quad_edge_counts(&data.quads);
         let info = Info {
             mesh: args.mesh,
             format,
@@ -136,7 +139,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             surfaces: data.surfaces().len(),
             components: 0,
             odd_components: 0,
-            boundary_edges: quad_boundary_edges(&data.quads),
+            boundary_edges,
+            junction_edges,
             candidate_pairs: 0,
             valid_pairs: 0,
             reoriented_triangles: 0,
@@ -176,6 +180,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         components: topo.component_sizes.len(),
         odd_components: topo.component_sizes.iter().filter(|&&s| s % 2 == 1).count(),
         boundary_edges: topo.num_boundary_edges,
+        junction_edges: topo.num_junction_edges,
         candidate_pairs: table.len(),
         valid_pairs: table
             .eta
@@ -235,6 +240,13 @@ fn text(i: &Info) -> String {
         i.odd_components
     );
     wln!(s, "boundary edges:       {}", i.boundary_edges);
+    if i.junction_edges > 0 {
+        wln!(
+            s,
+            "junction edges:       {} (three or more elements: surfaces meet there)",
+            i.junction_edges
+        );
+    }
     wln!(
         s,
         "candidate pairs:      {} ({} make a valid quad, eta > 0)",
@@ -298,15 +310,17 @@ fn text(i: &Info) -> String {
     s
 }
 
-/// Edges used by exactly one quad (a mesh of quads only has no topology built).
-fn quad_boundary_edges(quads: &[[u32; 4]]) -> usize {
+/// Edges used by exactly one quad, and by three or more (a mesh of quads only has no
+/// topology built).
+fn quad_edge_counts(quads: &[[u32; 4]]) -> (usize, usize) {
     let mut edges: Vec<(u32, u32)> = quads
         .iter()
         .flat_map(|q| (0..4).map(move |i| (q[i].min(q[(i + 1) % 4]), q[i].max(q[(i + 1) % 4]))))
         .collect();
     edges.sort_unstable();
-    edges
-        .chunk_by(|a, b| a == b)
-        .filter(|run| run.len() == 1)
-        .count()
+    let uses = || edges.chunk_by(|a, b| a == b).map(<[_]>::len);
+    (
+        uses().filter(|&n| n == 1).count(),
+        uses().filter(|&n| n > 2).count(),
+    )
 }

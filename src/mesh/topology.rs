@@ -18,6 +18,8 @@ pub struct Topology {
     pub num_edges: usize,
     /// Number of edges used by exactly one element (triangle or quad).
     pub num_boundary_edges: usize,
+    /// Number of edges used by three or more elements (surfaces meeting there).
+    pub num_junction_edges: usize,
     /// Number of triangles in each connected component of the dual graph, the components
     /// numbered in order of their first triangle.
     pub component_sizes: Vec<u32>,
@@ -301,13 +303,14 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
         }
     };
     let mut neighbours = vec![[NONE; 3]; nt];
-    let (mut num_edges, mut num_boundary_edges) = (0, 0);
+    let (mut num_edges, mut num_boundary_edges, mut num_junction_edges) = (0, 0, 0);
     for (a, b, group) in half.groups() {
         if overfull_surface(group, surface_of).is_some() {
             return Err(half.non_manifold(&data.vertex_ids, element_id, surface_of));
         }
         num_edges += 1;
         num_boundary_edges += usize::from(group.len() == 1);
+        num_junction_edges += usize::from(group.len() > 2);
         let side = |t: u32| side_of(data.triangles[t as usize], a, b);
         // Two triangles of one surface on the edge are neighbours (at most two per surface).
         for (i, &(_, t)) in group.iter().enumerate() {
@@ -401,6 +404,7 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             num_edges,
             neighbours,
             num_boundary_edges,
+            num_junction_edges,
             component_sizes,
         },
     })

@@ -701,6 +701,60 @@ fn compressed_input_names_the_command_that_decompresses_it() {
     }
 }
 
+/// `info` counts the edges where surfaces meet (three or more elements), on a triangle mesh
+/// and on a mesh of quads only (the box and wall finished to all quads), as counted here
+/// from the file's elements.
+#[test]
+fn info_counts_the_edges_where_surfaces_meet() {
+    let dir = tempfile::tempdir().unwrap();
+    let box_wall = data("box_wall_41_ascii.msh");
+    let args = [
+        "--algo",
+        "selective",
+        "--finish",
+        "--all-quad",
+        "-o",
+        "aq.msh",
+    ];
+    let mut all = vec!["recombine", box_wall.to_str().unwrap()];
+    all.extend(args);
+    run_ok(dir.path(), &all);
+    for path in [
+        data("stiffened_41_ascii.msh"),
+        box_wall.clone(),
+        dir.path().join("aq.msh"),
+    ] {
+        let file = msh::parse(&path, &std::fs::read(&path).unwrap()).unwrap();
+        let mut uses: std::collections::HashMap<(u32, u32), usize> = Default::default();
+        let sides = |e: &[u32]| -> Vec<(u32, u32)> {
+            (0..e.len())
+                .map(|i| {
+                    (
+                        e[i].min(e[(i + 1) % e.len()]),
+                        e[i].max(e[(i + 1) % e.len()]),
+                    )
+                })
+                .collect()
+        };
+        let elements = (file.data.triangles.iter().map(|t| sides(t)))
+            .chain(file.data.quads.iter().map(|q| sides(q)));
+        for side in elements.flatten() {
+            *uses.entry(side).or_default() += 1;
+        }
+        let want = uses.values().filter(|&&n| n > 2).count();
+        assert!(want > 10, "{}", path.display());
+        let out = run_ok(dir.path(), &["info", "--json", path.to_str().unwrap()]);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["junction_edges"], want, "{}", path.display());
+        let text = run_ok(dir.path(), &["info", path.to_str().unwrap()]);
+        let text = String::from_utf8_lossy(&text.stdout).to_string();
+        assert!(
+            text.contains(&format!("junction edges:       {want} ")),
+            "{text}"
+        );
+    }
+}
+
 /// `two_squares_41_ascii.msh` with the header of its second surface's triangle block
 /// (`2 2 2 22`: dimension, entity, type, count) replaced, written to `dir`; and the line.
 fn two_squares_with_block_header(dir: &Path, header: &str) -> (PathBuf, usize) {
