@@ -48,7 +48,7 @@ pub(crate) fn split(
     let pairing = &chosen.pairing;
     let mut data = editable_copy(mesh);
     let first_node = mesh.vertex_ids.iter().max().copied().unwrap_or(0) + 1;
-    let first_element = mesh.triangle_ids.iter().max().copied().unwrap_or(0) + 1;
+    let first_element = first_free_element_tag(mesh);
     let mut splits = Vec::new();
     // (first half, the triangle across its inner side), (second half, ...) per split.
     let mut half_pairs = Vec::new();
@@ -188,9 +188,13 @@ pub(crate) fn split_model_edge(
 }
 
 /// `mesh`'s data, to add nodes and elements to (split sides, sheets): the input quads keep
-/// their corners and surfaces, not their tags (`Mesh::new` numbers them after the triangles,
-/// so the tags of added triangles cannot collide with them).
+/// their corners and surfaces, not their tags (a [`Mesh`] does not keep them): they are
+/// numbered after the largest triangle tag, and added elements after them
+/// ([`first_free_element_tag`]). Numbering them from the triangle count up, as an empty
+/// list would, collided with the triangles' own tags in a Gmsh file, whose point and line
+/// elements come first ("element tag 75 is given to two elements").
 pub(crate) fn editable_copy(mesh: &Mesh) -> MeshData {
+    let after = max_triangle_tag(mesh);
     MeshData {
         vertices: mesh.vertices.clone(),
         vertex_ids: mesh.vertex_ids.clone(),
@@ -198,8 +202,17 @@ pub(crate) fn editable_copy(mesh: &Mesh) -> MeshData {
         triangle_ids: mesh.triangle_ids.clone(),
         triangle_surface: mesh.triangle_surface.clone(),
         quads: mesh.quads.clone(),
-        quad_ids: Vec::new(),
+        quad_ids: (1..=mesh.quads.len() as u64).map(|k| after + k).collect(),
         quad_surface: mesh.quad_surface.clone(),
         model: mesh.model.clone(),
     }
+}
+
+fn max_triangle_tag(mesh: &Mesh) -> u64 {
+    mesh.triangle_ids.iter().max().copied().unwrap_or(0)
+}
+
+/// The first element tag no element of [`editable_copy`]`(mesh)` has.
+pub(crate) fn first_free_element_tag(mesh: &Mesh) -> u64 {
+    max_triangle_tag(mesh) + mesh.quads.len() as u64 + 1
 }

@@ -261,7 +261,7 @@ pub(crate) fn refine(
     }
     stats.nodes = data.vertices.len() - mesh.vertices.len();
 
-    let first_element = mesh.triangle_ids.iter().max().copied().unwrap_or(0) + 1;
+    let first_element = super::all_quad::first_free_element_tag(mesh);
     let mut next_element = first_element;
     let mut replaced = vec![false; nt];
     // The two triangles of each new quad, to pair them.

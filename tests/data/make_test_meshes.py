@@ -172,3 +172,17 @@ for d, t in gmsh.model.getEntities(0):
 gmsh.model.mesh.generate(2)
 write("box_wall_41_ascii.msh", 4.1, 0)
 gmsh.finalize()
+
+# Two unit squares side by side, the right one recombined by Gmsh (input quads) and the left
+# one of 73 triangles: all-quad must split a side of the odd left square, on a file whose
+# point and line elements take the first element tags (tests/it/all_quad.rs).
+start("mixed_odd")
+occ = gmsh.model.occ
+a = occ.addRectangle(0, 0, 0, 1, 1)
+b = occ.addRectangle(1, 0, 0, 1, 1)
+occ.fragment([(2, a)], [(2, b)])
+gmsh.model.occ.synchronize()
+gmsh.model.mesh.setRecombine(2, b)
+mesh(0.22)
+write("mixed_odd_41_ascii.msh", 4.1, 0)
+gmsh.finalize()

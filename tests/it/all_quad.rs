@@ -468,6 +468,36 @@ fn cli_all_quad_sheets_cross_edges_where_three_surfaces_meet() {
     check_written(&input, &tmp.path().join("out.msh"));
 }
 
+/// A Gmsh file with input quads (one square recombined by Gmsh, the other of 73 triangles):
+/// the split's new triangle gets a tag no element has. The input quads were renumbered from
+/// the triangle count up, onto the triangles' own tags (a Gmsh file's point and line
+/// elements come first), and every such all-quad failed: "element tag 75 is given to two
+/// elements".
+#[test]
+fn cli_all_quad_on_a_gmsh_file_with_input_quads() {
+    if !python_module_available("meshio") {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let input = repo_path("tests/data/mixed_odd_41_ascii.msh");
+    let args = [
+        "--algo",
+        "selective",
+        "--finish",
+        "--all-quad",
+        "--json",
+        "-o",
+        "out.msh",
+    ];
+    let mut all = vec!["recombine", input.to_str().unwrap()];
+    all.extend(args);
+    let out = run_ok(tmp.path(), &all);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["finish"]["triangles_left"], 0, "{v}");
+    let c = check_written(&input, &tmp.path().join("out.msh"));
+    assert!(c.new_nodes > 0, "{c:?}");
+}
+
 #[test]
 fn all_quad_sheet_stops_with_an_error_at_an_input_quad() {
     let mesh = Mesh::new(MeshData {
