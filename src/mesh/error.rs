@@ -130,7 +130,8 @@ impl ReadError {
         {
             out.as_mut_os_string().push(".msh");
         }
-        if out == path {
+        // Never the input, nor a file that exists (the user's other mesh).
+        if out == path || out.exists() {
             out.set_extension("decompressed.msh");
         }
         ReadError::Compressed {

@@ -659,6 +659,8 @@ fn compressed_input_names_the_command_that_decompresses_it() {
         ("m.msh", "m.decompressed.msh"),
         // Spaces, a quote and a leading dash: quoted, and not read as an option.
         ("-it's a mesh.MSH.GZ", "-it's a mesh.MSH"),
+        // two.msh exists now (the first case wrote it): not written over.
+        ("two.msh.gz", "two.decompressed.msh"),
     ] {
         let p = dir.path().join(name);
         std::fs::write(&p, &zipped).unwrap();
