@@ -432,8 +432,15 @@ fn all_quad_refines_a_lone_triangle_into_three_quads() {
     assert!(matches!(written.check(), None | Some(1)));
 }
 
-/// A sheet that reaches a side shared with an input quad cannot go on conformingly: a clear
-/// error naming the element and the side, nothing half made.
+/// `recombine INPUT --algo selective --finish --all-quad --json -o out.msh` in `dir`: its
+/// JSON object (the command must succeed).
+fn cli_all_quad(dir: &Path, input: &Path) -> serde_json::Value {
+    let mut args = vec!["recombine", input.to_str().unwrap()];
+    args.extend(["--algo", "selective", "--finish", "--all-quad", "--json"]);
+    args.extend(["-o", "out.msh"]);
+    serde_json::from_slice(&run_ok(dir, &args).stdout).unwrap()
+}
+
 /// Sheets cross edges where three surfaces meet (a box's faces and a wall across it, shells
 /// with odd surfaces that no split fixes, a Gmsh mesh): every surface on such an edge gets
 /// its midpoint, so the output conforms (checked by meshio: no hanging edge, every edge used
@@ -446,19 +453,7 @@ fn cli_all_quad_sheets_cross_edges_where_three_surfaces_meet() {
     }
     let tmp = tempfile::tempdir().unwrap();
     let input = repo_path("tests/data/box_wall_41_ascii.msh");
-    let args = [
-        "--algo",
-        "selective",
-        "--finish",
-        "--all-quad",
-        "--json",
-        "-o",
-        "out.msh",
-    ];
-    let mut all = vec!["recombine", input.to_str().unwrap()];
-    all.extend(args);
-    let out = run_ok(tmp.path(), &all);
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = cli_all_quad(tmp.path(), &input);
     assert!(v["finish"]["sheets"]["sheets"].as_u64().unwrap() > 0, "{v}");
     let script = include_str!("all_quad_check.py");
     let text = python(script, &[input.as_path(), &tmp.path().join("out.msh")]);
@@ -480,24 +475,14 @@ fn cli_all_quad_on_a_gmsh_file_with_input_quads() {
     }
     let tmp = tempfile::tempdir().unwrap();
     let input = repo_path("tests/data/mixed_odd_41_ascii.msh");
-    let args = [
-        "--algo",
-        "selective",
-        "--finish",
-        "--all-quad",
-        "--json",
-        "-o",
-        "out.msh",
-    ];
-    let mut all = vec!["recombine", input.to_str().unwrap()];
-    all.extend(args);
-    let out = run_ok(tmp.path(), &all);
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = cli_all_quad(tmp.path(), &input);
     assert_eq!(v["finish"]["triangles_left"], 0, "{v}");
     let c = check_written(&input, &tmp.path().join("out.msh"));
     assert!(c.new_nodes > 0, "{c:?}");
 }
 
+/// A sheet that reaches a side shared with an input quad cannot go on conformingly: a clear
+/// error naming the element and the side, nothing half made.
 #[test]
 fn all_quad_sheet_stops_with_an_error_at_an_input_quad() {
     let mesh = Mesh::new(MeshData {
