@@ -183,7 +183,7 @@ impl Rule {
 
 /// eta at or below which a quad is flat to within rounding: a corner of 180 degrees (a node
 /// at the midpoint of its neighbours, as Gmsh's meshers place some) comes out of eq. 1 in
-/// f64 as eta 0 or as a few units of 1e-16 either way (5.6e-16 to 7.1e-15 on the suite's
+/// f64 as eta 0 or as a few units of 1e-16 to 1e-15 (5.6e-16 to 8.8e-15 on the suite's
 /// plate meshes and on a shell a review found, where all-quad's halves of such a quad then
 /// read as eta 0 and failed). 1e-12, a corner within 1.6e-12 radians of 180 degrees, is a
 /// thousand times that noise; no eta of `borouchaki`, `sphere` or the generated grids lies

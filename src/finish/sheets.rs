@@ -16,7 +16,8 @@
 use super::region::Pairing;
 use crate::mesh::{Mesh, MeshData, MeshError, NONE};
 use crate::quality::{CandidateTable, Rule, quad_eta};
-use std::collections::HashMap;
+use std::collections::hash_map::Entry;
+use std::collections::{HashMap, HashSet};
 
 /// What sheet refinement changed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -119,7 +120,7 @@ pub(crate) fn refine(
     let mut cut = vec![false; table.len()];
     let mut side_done = vec![[false; 3]; nt];
     // Sides of input quads: a sheet cannot cross them (the quad is never split).
-    let quad_sides: std::collections::HashSet<[u32; 2]> = mesh
+    let quad_sides: HashSet<[u32; 2]> = mesh
         .quads
         .iter()
         .flat_map(|q| (0..4).map(move |i| key(q[i], q[(i + 1) % 4])))
@@ -139,15 +140,15 @@ pub(crate) fn refine(
             let mut first = true;
             while let Some((cur, a, b)) = todo.pop() {
                 match mids.entry(key(a, b)) {
-                    std::collections::hash_map::Entry::Vacant(v) => {
+                    Entry::Vacant(v) => {
                         v.insert(first_vertex + mid_order.len() as u32);
                         mid_order.push((key(a, b), mesh.triangle_surface[cur as usize]));
                     }
                     // Reached again (a sheet through a side shared by three or more
                     // elements can come back to it): whoever gave it its midpoint went on
                     // across every element on it.
-                    std::collections::hash_map::Entry::Occupied(_) if !first => continue,
-                    std::collections::hash_map::Entry::Occupied(_) => {}
+                    Entry::Occupied(_) if !first => continue,
+                    Entry::Occupied(_) => {}
                 }
                 first = false;
                 if quad_sides.contains(&key(a, b)) {

@@ -158,8 +158,9 @@ impl MeshData {
 impl Mesh {
     /// Validates `data` and builds the mesh: finite coordinates, node indices in range, no
     /// repeated node in an element, no zero-area or duplicate triangle, no edge shared by more
-    /// than two elements of one surface (surfaces may meet three or more at an edge); inconsistent orientations are fixed (and counted in `reoriented`)
-    /// where the surface is orientable, and an error otherwise.
+    /// than two elements of one surface (surfaces may meet three or more at an edge);
+    /// inconsistent orientations are fixed (and counted in `reoriented`) where the surface is
+    /// orientable, and an error otherwise.
     pub fn new(data: MeshData) -> Result<Mesh, MeshError> {
         topology::build(data)
     }

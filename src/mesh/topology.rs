@@ -650,6 +650,7 @@ mod tests {
                 mesh.topology.num_boundary_edges,
                 mesh.topology.num_edges - 1
             );
+            assert_eq!(mesh.topology.num_junction_edges, 1);
         };
         // One triangle of each of three surfaces (a T: a web on the line between two panels).
         check(with(&[([0, 2, 4], 3)], [1, 2]), 0, vec![1, 1, 1]);
