@@ -468,3 +468,119 @@ fn lines_on_missing_nodes_are_refused() {
         "{msg}"
     );
 }
+
+/// A volume element (skipped: neither kept nor written) naming a node the file lacks is
+/// refused too, as Gmsh refuses such a file, in each of the four element readers: MSH 2.2
+/// and 4.1, ASCII (the element's line) and binary (its byte offset). The same files with
+/// the tetrahedron on an existing node are read, its element counted as skipped.
+#[test]
+fn skipped_elements_on_missing_nodes_are_refused() {
+    let cases = |node: u64| -> Vec<(&'static str, Vec<u8>, String)> {
+        let v22 = format!(
+            "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n\
+             $EndNodes\n$Elements\n2\n1 2 2 1 1 1 2 3\n2 4 2 1 1 1 2 3 {node}\n$EndElements\n"
+        );
+        let v41 = format!(
+            "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 3 1 3\n2 1 0 3\n1\n2\n3\n0 0 0\n\
+             1 0 0\n0 1 0\n$EndNodes\n$Elements\n2 2 1 2\n2 1 2 1\n1 1 2 3\n3 1 4 1\n\
+             2 1 2 3 {node}\n$EndElements\n"
+        );
+        vec![
+            ("a22.msh", v22.into_bytes(), ":13:".to_string()),
+            ("a41.msh", v41.into_bytes(), ":19:".to_string()),
+            (
+                "b22.msh",
+                msh22_binary_tet(node),
+                "byte offset ".to_string(),
+            ),
+            (
+                "b41.msh",
+                msh41_binary_tet(node),
+                "byte offset ".to_string(),
+            ),
+        ]
+    };
+    for (name, bytes, at) in cases(9) {
+        let err = msh::read_bytes(name, &bytes).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            msg.contains(name)
+                && msg.contains(&at)
+                && msg.contains("element 2 refers to node 9, which does not exist"),
+            "{name}: {msg}"
+        );
+    }
+    for (name, bytes, _) in cases(3) {
+        let m = msh::read_bytes(name, &bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(m.num_triangles(), 1, "{name}");
+    }
+}
+
+/// MSH 2.2 binary: nodes 1..3 and one triangle (element 1), then a tetrahedron (element 2)
+/// on nodes 1, 2, 3 and `node`.
+fn msh22_binary_tet(node: u64) -> Vec<u8> {
+    let mut b = b"$MeshFormat\n2.2 1 8\n".to_vec();
+    b.extend(1i32.to_le_bytes());
+    b.extend(b"\n$EndMeshFormat\n$Nodes\n3\n");
+    for (tag, x, y) in [(1i32, 0.0f64, 0.0f64), (2, 1.0, 0.0), (3, 0.0, 1.0)] {
+        b.extend(tag.to_le_bytes());
+        for c in [x, y, 0.0] {
+            b.extend(c.to_le_bytes());
+        }
+    }
+    b.extend(b"\n$EndNodes\n$Elements\n2\n");
+    // Group header (type, count, number of tags), then tag, tags, nodes.
+    for (etype, tag, nodes) in [
+        (2i32, 1i32, vec![1i32, 2, 3]),
+        (4, 2, vec![1, 2, 3, node as i32]),
+    ] {
+        for x in [etype, 1, 2, tag, 1, 1] {
+            b.extend(x.to_le_bytes());
+        }
+        for n in nodes {
+            b.extend(n.to_le_bytes());
+        }
+    }
+    b.extend(b"\n$EndElements\n");
+    b
+}
+
+/// MSH 4.1 binary (no `$Entities`): the same nodes and elements as [`msh22_binary_tet`],
+/// the triangle on surface 1, the tetrahedron on volume 1.
+fn msh41_binary_tet(node: u64) -> Vec<u8> {
+    let mut b = b"$MeshFormat\n4.1 1 8\n".to_vec();
+    b.extend(1i32.to_le_bytes());
+    b.extend(b"\n$EndMeshFormat\n$Nodes\n");
+    for x in [1u64, 3, 1, 3] {
+        b.extend(x.to_le_bytes());
+    }
+    for x in [2i32, 1, 0] {
+        b.extend(x.to_le_bytes());
+    }
+    b.extend(3u64.to_le_bytes());
+    for tag in [1u64, 2, 3] {
+        b.extend(tag.to_le_bytes());
+    }
+    for c in [0.0f64, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        b.extend(c.to_le_bytes());
+    }
+    b.extend(b"\n$EndNodes\n$Elements\n");
+    for x in [2u64, 2, 1, 2] {
+        b.extend(x.to_le_bytes());
+    }
+    for (dim, etype, tag, nodes) in [
+        (2i32, 2i32, 1u64, vec![1u64, 2, 3]),
+        (3, 4, 2, vec![1, 2, 3, node]),
+    ] {
+        for x in [dim, 1, etype] {
+            b.extend(x.to_le_bytes());
+        }
+        b.extend(1u64.to_le_bytes());
+        b.extend(tag.to_le_bytes());
+        for n in nodes {
+            b.extend(n.to_le_bytes());
+        }
+    }
+    b.extend(b"\n$EndElements\n");
+    b
+}

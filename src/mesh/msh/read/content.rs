@@ -9,7 +9,10 @@ use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
 /// Node tag -> dense vertex index.
 pub(super) enum NodeMap {
-    Dense(Vec<u32>),
+    /// Indexed by tag, and one bit per tag (a node has it) for [`NodeMap::contains`]: the
+    /// check of skipped elements' nodes, which needs no index, reads 64 tags per word (a
+    /// million tags in 128 KiB).
+    Dense(Vec<u32>, Vec<u64>),
     Sparse(HashMap<u64, u32>),
 }
 
@@ -19,14 +22,16 @@ impl NodeMap {
         let max = tags.iter().copied().max().unwrap_or(0);
         if max <= 4 * tags.len() as u64 + 1024 {
             let mut dense = vec![u32::MAX; max as usize + 1];
+            let mut known = vec![0u64; max as usize / 64 + 1];
             for (i, &t) in tags.iter().enumerate() {
                 let slot = &mut dense[t as usize];
                 if *slot != u32::MAX {
                     return Err(t);
                 }
                 *slot = i as u32;
+                known[t as usize / 64] |= 1 << (t % 64);
             }
-            Ok(NodeMap::Dense(dense))
+            Ok(NodeMap::Dense(dense, known))
         } else {
             let mut map = HashMap::with_capacity(tags.len());
             for (i, &t) in tags.iter().enumerate() {
@@ -41,8 +46,19 @@ impl NodeMap {
     #[inline]
     pub(super) fn get(&self, tag: u64) -> Option<u32> {
         match self {
-            NodeMap::Dense(v) => v.get(tag as usize).copied().filter(|&i| i != u32::MAX),
+            NodeMap::Dense(v, _) => v.get(tag as usize).copied().filter(|&i| i != u32::MAX),
             NodeMap::Sparse(m) => m.get(&tag).copied(),
+        }
+    }
+
+    /// Whether a node has `tag`.
+    #[inline]
+    pub(super) fn contains(&self, tag: u64) -> bool {
+        match self {
+            NodeMap::Dense(_, known) => known
+                .get((tag / 64) as usize)
+                .is_some_and(|w| w >> (tag % 64) & 1 == 1),
+            NodeMap::Sparse(m) => m.contains_key(&tag),
         }
     }
 }
@@ -236,6 +252,51 @@ impl Content {
     }
 }
 
+/// Checks that node `n` of skipped element `tag` exists: such an element is neither kept
+/// nor written, but a file naming a missing node is broken, and Gmsh refuses it too.
+#[inline]
+pub(super) fn check_node(p: &Parser<'_>, map: &NodeMap, at: usize, tag: u64, n: u64) -> Res<()> {
+    if map.contains(n) {
+        Ok(())
+    } else {
+        Err(p.err(at, missing_node(tag, n)))
+    }
+}
+
+/// [`check_node`] for every node of a block of skipped binary elements: `count` records of
+/// `stride` bytes from byte offset `at0`, `tag(e)` and `node(e, k)` reading a record's tag
+/// and its `nn` node tags. One pass without error paths; the element at fault is looked for
+/// only when one is.
+#[allow(clippy::too_many_arguments)] // one record layout, read by the two closures
+pub(super) fn check_block_nodes(
+    p: &Parser<'_>,
+    map: &NodeMap,
+    data: &[u8],
+    at0: usize,
+    stride: usize,
+    nn: usize,
+    tag: impl Fn(&[u8]) -> u64,
+    node: impl Fn(&[u8], usize) -> u64,
+) -> Res<()> {
+    let records = data.chunks_exact(stride);
+    if records
+        .clone()
+        .all(|e| (0..nn).all(|k| map.contains(node(e, k))))
+    {
+        return Ok(());
+    }
+    for (i, e) in records.enumerate() {
+        for k in 0..nn {
+            check_node(p, map, at0 + i * stride, tag(e), node(e, k))?;
+        }
+    }
+    unreachable!("a node that is not known was found")
+}
+
+fn missing_node(tag: u64, n: u64) -> String {
+    format!("element {tag} refers to node {n}, which does not exist")
+}
+
 /// Adds a triangle or quad (`nodes` are its 3 or 4 node tags) of element `tag` on `surface`, or counts an
 /// ignored element. `at` is where the element starts (for messages).
 #[inline]
@@ -250,10 +311,7 @@ pub(super) fn push_element(
 ) -> Res<()> {
     let mut idx = [0u32; 4];
     for (k, &n) in nodes.iter().enumerate() {
-        idx[k] = map.get(n).ok_or_else(|| {
-            let msg = format!("element {tag} refers to node {n}, which does not exist");
-            p.err(at, msg)
-        })?;
+        idx[k] = map.get(n).ok_or_else(|| p.err(at, missing_node(tag, n)))?;
     }
     if nodes.len() == 3 {
         c.data.triangles.push([idx[0], idx[1], idx[2]]);
@@ -282,12 +340,7 @@ pub(super) fn push_lower(
 ) -> Res<()> {
     let nodes = nodes
         .iter()
-        .map(|&n| {
-            map.get(n).ok_or_else(|| {
-                let msg = format!("element {tag} refers to node {n}, which does not exist");
-                p.err(at, msg)
-            })
-        })
+        .map(|&n| map.get(n).ok_or_else(|| p.err(at, missing_node(tag, n))))
         .collect::<Res<Vec<u32>>>()?;
     c.model.elements.push(Element {
         gmsh_type: etype,
@@ -311,10 +364,19 @@ mod tests {
     #[test]
     fn node_map_is_dense_for_compact_tags_and_sparse_otherwise() {
         let dense = NodeMap::new(&[3, 1, 2]).unwrap();
-        assert!(matches!(dense, NodeMap::Dense(_)));
+        assert!(matches!(dense, NodeMap::Dense(..)));
         assert_eq!(
             (dense.get(1), dense.get(3), dense.get(0), dense.get(99)),
             (Some(1), Some(0), None, None)
+        );
+        let has = |m: &NodeMap| [0, 1, 2, 3, 4, 63, 64, 99, u64::MAX].map(|t| m.contains(t));
+        let yes = [false, true, true, true, false, false, false, false, false];
+        assert_eq!(has(&dense), yes);
+        let wide = NodeMap::new(&[64, 1, 63]).unwrap();
+        assert!(matches!(wide, NodeMap::Dense(..)));
+        assert_eq!(
+            has(&wide),
+            [false, true, false, false, false, true, true, false, false]
         );
         let sparse = NodeMap::new(&[u64::MAX, 5]).unwrap();
         assert!(matches!(sparse, NodeMap::Sparse(_)));
@@ -322,6 +384,8 @@ mod tests {
             (sparse.get(u64::MAX), sparse.get(5), sparse.get(6)),
             (Some(0), Some(1), None)
         );
+        let hits = [u64::MAX, 5, 6, 0].map(|t| sparse.contains(t));
+        assert_eq!(hits, [true, true, false, false]);
         assert_eq!(NodeMap::new(&[4, 7, 4]).err(), Some(4));
         assert_eq!(NodeMap::new(&[u64::MAX, 9, u64::MAX]).err(), Some(u64::MAX));
     }

@@ -1,7 +1,9 @@
 //! The MSH 2.2 sections (also 2.0 and 2.1), in either encoding: `$Nodes`,
 //! `$ParametricNodes` and `$Elements` (one element per record, its tags before its nodes).
 
-use super::content::{Content, NodeMap, parametric, push_element, push_lower};
+use super::content::{
+    Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
+};
 use super::element_types::{
     MAX_LOWER_NODES, QUAD, TRIANGLE, element_nodes, element_type, is_lower, unknown_type,
     variable_size,
@@ -163,6 +165,8 @@ pub(super) fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMa
             let v = p.uint(s, &|| format!("node {} of element {tag}", k + 1))?;
             if let (true, Some(slot)) = (keep || lower, nodes.get_mut(k)) {
                 *slot = v;
+            } else {
+                check_node(p, map, at, tag, v)?;
             }
         }
         p.entry_end(&|| element_nodes(tag, etype, nn))?;
@@ -237,6 +241,12 @@ pub(super) fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeM
                     push_lower(p, c, map, at, tag as u64, t, surface, &nodes[..nn])?;
                 }
             }
+        } else {
+            // A negative node tag reads as 0, which no node has (node tags are positive).
+            let tag = |e: &[u8]| u64::try_from(i32_at(e, 0)).unwrap_or(0);
+            let node =
+                |e: &[u8], k: usize| u64::try_from(i32_at(e, 4 * (1 + ntags + k))).unwrap_or(0);
+            check_block_nodes(p, map, data, at0, stride, nn, tag, node)?;
         }
         if !keep {
             c.skip(etype, n as u64, false);

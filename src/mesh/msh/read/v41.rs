@@ -2,7 +2,9 @@
 //! (blocks per entity, with parametric coordinates) and `$Elements` (blocks per entity and
 //! type).
 
-use super::content::{Content, NodeMap, parametric, push_element, push_lower};
+use super::content::{
+    Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
+};
 use super::element_types::{
     MAX_LOWER_NODES, QUAD, TRIANGLE, element_nodes, element_type, is_lower, unknown_type,
     variable_size,
@@ -480,6 +482,8 @@ fn element_block41_ascii(
             let v = p.uint(s, &|| format!("node {} of element {tag}", k + 1))?;
             if let (true, Some(slot)) = (store, nodes.get_mut(k)) {
                 *slot = v;
+            } else {
+                check_node(p, map, at, tag, v)?;
             }
         }
         p.entry_end(&|| element_nodes(tag, b.etype, b.nodes))?;
@@ -525,6 +529,10 @@ fn element_block41_binary(
                 push_lower(p, c, map, at, tag, t, b.surface, &nodes[..nn])?;
             }
         }
+    } else {
+        let tag = |e: &[u8]| u64_at(e, 0);
+        let node = |e: &[u8], k: usize| u64_at(e, 8 + 8 * k);
+        check_block_nodes(p, map, data, at0, stride, nn, tag, node)?;
     }
     if !b.keep() {
         c.skip(b.etype, b.len, b.on_interface);
