@@ -44,6 +44,10 @@ echo "== cargo clippy"
 cargo clippy --all-targets -- -D warnings
 echo "== cargo test (release)"
 cargo test --release
+# Again with debug assertions (the test profile): the search state's internal consistency
+# checks and integer overflow checks, which the release build compiles out.
+echo "== cargo test (debug assertions)"
+cargo test
 echo "== cargo bench (each benchmark once, as a test)"
 cargo bench --bench benches -- --test
 echo "== cargo doc"

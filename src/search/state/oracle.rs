@@ -2,7 +2,7 @@
 //! every verdict against a from-scratch evaluation) and [`naive_allowed`], the criterion
 //! computed by a full search per candidate.
 
-use super::State;
+use super::{State, is_split};
 use crate::mesh::{Mesh, NONE};
 use crate::quality::CandidateTable;
 
@@ -38,12 +38,22 @@ impl State<'_> {
                 return Err(format!("P_{k} holds {members:?}, counts say {expect:?}"));
             }
         }
-        let naive = naive_allowed(self.mesh, self.table, &self.alive);
-        for (c, &ok) in naive.iter().enumerate() {
-            if ok != self.cand[c].verdict.allowed {
+        let naive = naive_parts(self.mesh, self.table, &self.alive);
+        for (c, &(ok, parts)) in naive.iter().enumerate() {
+            let v = &self.cand[c].verdict;
+            if ok != v.allowed {
                 return Err(format!(
                     "candidate {c}: allowed {} but the naive criterion says {ok}",
-                    self.cand[c].verdict.allowed
+                    v.allowed
+                ));
+            }
+            // A verdict that found one part (an apply then relabels nothing) must still be
+            // right; a split can have lost a part since (see `tree_push`).
+            if self.is_live(c as u32) && !is_split(v.kind) && parts >= 2 {
+                return Err(format!(
+                    "candidate {c}: a verdict of kind {} (one part) but its removal leaves \
+                     {parts} parts",
+                    v.kind
                 ));
             }
         }
@@ -55,6 +65,13 @@ impl State<'_> {
 /// neighbour of the pair, same rule: at most one odd part): the reference the fast state is
 /// tested against. `alive[t]` says which triangles remain.
 pub fn naive_allowed(mesh: &Mesh, table: &CandidateTable, alive: &[bool]) -> Vec<bool> {
+    let parts = naive_parts(mesh, table, alive);
+    parts.into_iter().map(|(ok, _)| ok).collect()
+}
+
+/// [`naive_allowed`] with, for each candidate, the number of parts its removal leaves of
+/// its polder (0 for a used candidate).
+fn naive_parts(mesh: &Mesh, table: &CandidateTable, alive: &[bool]) -> Vec<(bool, u32)> {
     debug_assert_eq!(mesh.num_triangles(), alive.len());
     let nb = &table.dual_graph();
     let nt = alive.len();
@@ -65,12 +82,12 @@ pub fn naive_allowed(mesh: &Mesh, table: &CandidateTable, alive: &[bool]) -> Vec
         .map(|c| {
             let [t0, t1] = table.pairs[c];
             if !alive[t0 as usize] || !alive[t1 as usize] {
-                return false;
+                return (false, 0);
             }
             epoch += 1;
             mark[t0 as usize] = epoch;
             mark[t1 as usize] = epoch;
-            let mut odd = 0;
+            let (mut odd, mut parts) = (0, 0);
             for &s in nb[t0 as usize].iter().chain(&nb[t1 as usize]) {
                 if s == NONE || !alive[s as usize] || mark[s as usize] == epoch {
                     continue;
@@ -88,8 +105,9 @@ pub fn naive_allowed(mesh: &Mesh, table: &CandidateTable, alive: &[bool]) -> Vec
                     }
                 }
                 odd += size & 1;
+                parts += 1;
             }
-            odd <= 1
+            (odd <= 1, parts)
         })
         .collect()
 }

@@ -534,6 +534,32 @@ fn forward_state_keeps_no_linked_split_verdict_across_an_action() {
     }
 }
 
+/// Selective h = 5 on the two-surface channel (one surface odd), every action replayed on
+/// a forward state against the naive criterion, the verdicts' kinds included: a verdict of
+/// a one-part kind must leave at most one part (an apply relabels nothing then). On these
+/// runs split verdicts become one part (a part used up by the action `shrink_split` kept
+/// them across), which `tree_push` took for impossible (a debug assertion, seen once the
+/// suite ran with debug assertions: `scripts/test-all.sh` now does).
+#[test]
+fn forward_state_replays_the_channel_runs_exactly() {
+    use quadrecomb::internals::search::{Algo, Searcher};
+    let path = crate::util::repo_path("tests/data/channel_41_ascii.msh");
+    let mesh = quadrecomb::internals::mesh::load(path.to_str().expect("utf-8 path"))
+        .expect("the test mesh");
+    let table = CandidateTable::build(&mesh).restrict(&mesh, Rule::default());
+    for seed in 0..4 {
+        let out = Searcher::new(&mesh, &table).run(Algo::selective(5), seed);
+        let mut state = State::new(&mesh, &table);
+        state.set_forward_uncopied();
+        for (i, &c) in out.chosen.iter().enumerate() {
+            state.apply(c);
+            state
+                .sanity_check()
+                .unwrap_or_else(|e| panic!("seed {seed}, after {} actions: {e}", i + 1));
+        }
+    }
+}
+
 /// Long soak over whole policy runs, not run by default (`cargo test --release --test it
 /// soak_policy -- --ignored`): on every mesh of the default suite and the committed grid with
 /// holes, under both rules, greedy and selective h = 1, 3 and 5 (two seeds each) are run, and
