@@ -212,7 +212,8 @@ pub fn check_records(
 /// out of its range, a non-finite or negative measure, an unknown algorithm, and, against the
 /// mesh's optimum when known: more quads than the optimum's (it pairs as many triangles as
 /// can be paired), a quality above it with as many quads (beyond the rounding of its integer
-/// weights), or a `quality_pct` that is not 100 x quality / optimum. A run with fewer quads
+/// weights), or a `quality_pct` that is not 100 x quality / optimum (or is missing with a
+/// positive optimum, or given with an optimum of 0). A run with fewer quads
 /// than the optimum may exceed its quality (see docs/search.md); it cannot exceed its quads
 /// (eta is at most 1).
 pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(), String> {
@@ -323,17 +324,25 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             r.quality, opt.quality
         ));
     }
-    if let Some(pct) = r.quality_pct {
-        if opt.quality > 0.0
-            && (pct - 100.0 * r.quality / opt.quality).abs() > 1e-6 * pct.abs().max(1.0)
-        {
-            return Err(format!(
+    // Present exactly when the optimum is positive: a report compares it across runs, and
+    // falls back to the sum of eta only for a mesh whose runs all lack it.
+    match r.quality_pct {
+        None if opt.quality > 0.0 => Err(format!(
+            "quality_pct is missing, but its mesh's optimum {} is recorded",
+            opt.quality
+        )),
+        Some(pct) if opt.quality <= 0.0 => Err(format!(
+            "quality_pct {pct} given, but its mesh's optimum is {}",
+            opt.quality
+        )),
+        Some(pct) if (pct - 100.0 * r.quality / opt.quality).abs() > 1e-6 * pct.abs().max(1.0) => {
+            Err(format!(
                 "quality_pct {pct} is not 100 x quality {} / optimum {}",
                 r.quality, opt.quality
-            ));
+            ))
         }
+        _ => Ok(()),
     }
-    Ok(())
 }
 
 /// Removes what an earlier sweep wrote into `dir`, and nothing else: only a directory with a
@@ -520,6 +529,11 @@ pub fn run(
     if dir.join(MANIFEST_FILE).exists() {
         let old = Manifest::read(dir)?;
         if opts.resume {
+            // The directory's configuration given in another order is the directory's own
+            // (not for a shard: its slice of the run list depends on the order).
+            if manifest.shard.is_none() && manifest.spec.is_reordering_of(&old.spec) {
+                manifest.spec = old.spec.clone();
+            }
             check_resume(dir, &old, &manifest, opts.extend)?;
             // The records are checked against the directory's own manifest before it is
             // rewritten: a refused directory keeps its manifest. An extension plans every run
@@ -725,6 +739,49 @@ pub(crate) mod tests {
         );
     }
 
+    /// The directory's own configuration with its algorithms, horizons and meshes in another
+    /// order resumes it (its manifest and records unchanged); a shard's does not (its slice
+    /// depends on the order), nor does a reordering that also changes something else.
+    #[test]
+    fn resume_takes_the_same_configuration_in_another_order() {
+        let tmp = tempfile::tempdir().unwrap();
+        let m = manifest(None);
+        let no = AtomicBool::new(false);
+        run(&m, &OK, &opts(tmp.path(), 1, false), &no, &mut |_| {}).unwrap();
+        let before = std::fs::read(tmp.path().join(RUNS_FILE)).unwrap();
+        let mut shuffled = m.clone();
+        shuffled.spec.algos.reverse();
+        shuffled.spec.horizons = vec![3, 1, 2];
+        shuffled.spec.meshes.reverse();
+        assert!(shuffled.spec.is_reordering_of(&m.spec));
+        let rep = run(&shuffled, &OK, &opts(tmp.path(), 1, true), &no, &mut |_| {}).unwrap();
+        assert_eq!((rep.already, rep.done_now), (40, 0));
+        assert_eq!(Manifest::read(tmp.path()).unwrap().spec, m.spec);
+        assert_eq!(std::fs::read(tmp.path().join(RUNS_FILE)).unwrap(), before);
+        let mut other = m.clone();
+        other.spec.horizons = vec![3, 1, 1];
+        assert!(!other.spec.is_reordering_of(&m.spec));
+        let err = run(&other, &OK, &opts(tmp.path(), 1, true), &no, &mut |_| {}).unwrap_err();
+        assert!(
+            err.to_string().contains("horizons [3, 1, 1] vs [1, 2, 3]"),
+            "{err}"
+        );
+        let shard = Some(Shard { index: 0, count: 2 });
+        let dir = tmp.path().join("shard");
+        run(
+            &manifest(shard),
+            &OK,
+            &opts(&dir, 1, false),
+            &no,
+            &mut |_| {},
+        )
+        .unwrap();
+        let mut part = manifest(shard);
+        part.spec.algos.reverse();
+        let err = run(&part, &OK, &opts(&dir, 1, true), &no, &mut |_| {}).unwrap_err();
+        assert!(err.to_string().contains("algorithms"), "{err}");
+    }
+
     #[test]
     fn extend_adds_runs_keeps_the_records_and_refuses_to_drop_any() {
         let tmp = tempfile::tempdir().unwrap();
@@ -798,9 +855,30 @@ pub(crate) mod tests {
         };
         let r = make_record(&m, &job, out);
         assert_eq!(r.quality_pct, Some(75.0));
+        let checked = RunRecord {
+            quality: 3.0,
+            quality_pct: Some(15.0),
+            ..r.clone()
+        };
         assert_eq!(r.recombined_pct, 80.0);
         // 6 nodes expanded per tree at h = 2: 1 + b = 6 -> b = 5.
         assert!((r.branching_factor.unwrap() - 5.0).abs() < 1e-9);
         assert_eq!(r.seed, job.seed);
+        let opt = &m.optimum[0];
+        assert_eq!(check_values(&checked, Some(opt)), Ok(()));
+        // The percentage goes with a positive optimum, and only with one.
+        let missing = RunRecord {
+            quality_pct: None,
+            ..checked.clone()
+        };
+        let err = check_values(&missing, Some(opt)).unwrap_err();
+        assert!(err.contains("quality_pct is missing"), "{err}");
+        let zero = OptimumEntry {
+            quality: 0.0,
+            ..opt.clone()
+        };
+        let err = check_values(&checked, Some(&zero)).unwrap_err();
+        assert!(err.contains("quality_pct 15 given"), "{err}");
+        assert_eq!(check_values(&missing, Some(&zero)), Ok(()));
     }
 }

@@ -96,6 +96,32 @@ impl SweepSpec {
         crate::quality::Rule::new(self.min_eta, self.allow_invalid)
             .unwrap_or(crate::quality::Rule::AllPairs)
     }
+
+    /// Whether this is `other` with its meshes, algorithms, horizons or budgets listed in
+    /// another order (`--algo optimum greedy selective --horizons 2,1` for a directory made
+    /// with `--algo selective greedy optimum --horizons 1,2`): the same runs, since a run's
+    /// seed derives from its configuration, not from its place in the run list.
+    pub fn is_reordering_of(&self, other: &SweepSpec) -> bool {
+        fn permutation<T: PartialEq>(a: &[T], b: &[T]) -> bool {
+            let count = |v: &[T], x: &T| v.iter().filter(|y| *y == x).count();
+            a.len() == b.len() && a.iter().all(|x| count(a, x) == count(b, x))
+        }
+        let mut same = self.clone();
+        if !permutation(&self.meshes, &other.meshes)
+            || !permutation(&self.algos, &other.algos)
+            || !permutation(&self.horizons, &other.horizons)
+            || !permutation(&self.budgets, &other.budgets)
+            || !permutation(&self.time_budgets, &other.time_budgets)
+        {
+            return false;
+        }
+        same.meshes.clone_from(&other.meshes);
+        same.algos.clone_from(&other.algos);
+        same.horizons.clone_from(&other.horizons);
+        same.budgets.clone_from(&other.budgets);
+        same.time_budgets.clone_from(&other.time_budgets);
+        same == *other
+    }
 }
 
 /// One mesh of a sweep. Two entries are the same mesh when their name, content hash and

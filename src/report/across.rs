@@ -39,7 +39,7 @@ struct Cell {
 struct Medians<'r> {
     /// Meshes with a quality % of the optimum, in report order.
     meshes: Vec<&'r str>,
-    /// Meshes left out (no optimum recorded, so no % to compare across meshes).
+    /// Meshes left out (no optimum recorded, or one of 0: no % to compare across meshes).
     left_out: Vec<&'r str>,
     /// Methods in report order ([`Config::method`]: a configuration without its mesh or a
     /// time budget's calibrated knob), the optimum left out.
@@ -314,8 +314,8 @@ pub(super) fn across_meshes(
     doc.heading(2, "Across meshes");
     if !m.left_out.is_empty() {
         doc.para(format!(
-            "Left out: {} (no optimum recorded, so no quality as % of the optimum to compare \
-             across meshes).",
+            "Left out: {} (no optimum recorded, or an optimum of 0 (no quad possible), so no \
+             quality as % of the optimum to compare across meshes).",
             m.left_out.join(", ")
         ));
     }

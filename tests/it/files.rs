@@ -409,6 +409,16 @@ fn report_and_merge_refuse_records_no_run_can_have() {
             "line 4".into(),
         ),
         (
+            // A percentage beside other runs' raw sums would be compared with them.
+            "quality_pct is missing, but its mesh's optimum",
+            {
+                let mut l = good.clone();
+                l[3] = edit_line(&l[3], |v| v["quality_pct"] = serde_json::Value::Null);
+                l
+            },
+            "line 4".into(),
+        ),
+        (
             "above the exact optimum",
             {
                 let mut l = good.clone();
