@@ -38,6 +38,10 @@ struct Info {
     boundary_edges: usize,
     /// Edges of three or more elements: where surfaces meet (shell models).
     junction_edges: usize,
+    /// Element nodes at exactly the position of another element node (distinct tags): the
+    /// elements there are not joined, the mesh has a crack (surfaces meshed apart, not
+    /// merged). Each node beyond the first at a position counts.
+    coincident_nodes: usize,
     candidate_pairs: usize,
     /// Candidate pairs whose quad is strictly convex (eta > 0): the actions under the
     /// default rule.
@@ -130,6 +134,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 source,
             })?;
         let (boundary_edges, junction_edges) = quad_edge_counts(&data.quads);
+        let coincident_nodes = coincident(&data.vertices, data.quads.iter().flatten());
         let info = Info {
             mesh: args.mesh,
             format,
@@ -141,6 +146,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             odd_components: 0,
             boundary_edges,
             junction_edges,
+            coincident_nodes,
             candidate_pairs: 0,
             valid_pairs: 0,
             reoriented_triangles: 0,
@@ -181,6 +187,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         odd_components: topo.component_sizes.iter().filter(|&&s| s % 2 == 1).count(),
         boundary_edges: topo.num_boundary_edges,
         junction_edges: topo.num_junction_edges,
+        coincident_nodes: coincident(
+            &m.vertices,
+            m.triangles.iter().flatten().chain(m.quads.iter().flatten()),
+        ),
         candidate_pairs: table.len(),
         valid_pairs: table
             .eta
@@ -201,6 +211,21 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         },
     };
     print(&info, args.json)
+}
+
+/// How many of the vertices that `used` names (with repeats) lie exactly where another of
+/// them lies (each beyond the first at a position; -0 and 0 are one coordinate).
+fn coincident<'a>(vertices: &[[f64; 3]], used: impl Iterator<Item = &'a u32>) -> usize {
+    let mut seen = vec![false; vertices.len()];
+    let mut at = Vec::new();
+    for &v in used {
+        if !std::mem::replace(&mut seen[v as usize], true) {
+            // Adding 0.0 turns -0.0 into 0.0.
+            at.push(vertices[v as usize].map(|x| (x + 0.0).to_bits()));
+        }
+    }
+    at.sort_unstable();
+    at.windows(2).filter(|w| w[0] == w[1]).count()
 }
 
 /// eta of each input quad (checked vertex indices): [`quality::input_quad_eta`], whose
@@ -245,6 +270,15 @@ fn text(i: &Info) -> String {
             s,
             "junction edges:       {} (three or more elements: surfaces meet there)",
             i.junction_edges
+        );
+    }
+    if i.coincident_nodes > 0 {
+        wln!(
+            s,
+            "coincident nodes:     {} (at the position of another node: the elements there are \
+             not joined, a crack; merge them: Gmsh's Coherence Mesh, \
+             gmsh.model.mesh.removeDuplicateNodes())",
+            i.coincident_nodes
         );
     }
     wln!(

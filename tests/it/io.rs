@@ -757,6 +757,48 @@ fn info_counts_the_edges_where_surfaces_meet() {
     }
 }
 
+/// `info` counts element nodes lying exactly where another element node lies (a crack:
+/// the elements on either side are not joined), on triangles and on quad-only files; an
+/// unused node does not count, -0 is 0, and Gmsh's conforming two squares have none.
+#[test]
+fn info_counts_coincident_nodes() {
+    let dir = tempfile::tempdir().unwrap();
+    // A unit square split along its diagonal, the second triangle on copies of the
+    // diagonal's nodes (5 and 6, one written with -0), and node 7 unused on node 2.
+    let nodes =
+        "$Nodes\n7\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 -0 0 0\n6 1 1 0\n7 1 0 0\n$EndNodes\n";
+    let header = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+    let tri =
+        format!("{header}{nodes}$Elements\n2\n1 2 2 1 1 1 2 3\n2 2 2 1 1 5 6 4\n$EndElements\n");
+    // Two quads side by side, the second on copies of the shared side's nodes.
+    let quad = format!(
+        "{header}$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 1 0 0\n6 2 0 0\n7 2 1 0\n\
+         8 1 1 0\n$EndNodes\n$Elements\n2\n1 3 2 1 1 1 2 3 4\n2 3 2 1 1 5 6 7 8\n$EndElements\n"
+    );
+    let joined = data("two_squares_41_ascii.msh");
+    for (name, text, want) in [
+        ("tri.msh", Some(tri), 2),
+        ("quad.msh", Some(quad), 2),
+        ("", None, 0),
+    ] {
+        let path = match text {
+            Some(t) => {
+                let p = dir.path().join(name);
+                std::fs::write(&p, t).unwrap();
+                p
+            }
+            None => joined.clone(),
+        };
+        let out = run_ok(dir.path(), &["info", "--json", path.to_str().unwrap()]);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["coincident_nodes"], want, "{}", path.display());
+        let text = run_ok(dir.path(), &["info", path.to_str().unwrap()]);
+        let text = String::from_utf8_lossy(&text.stdout).to_string();
+        let line = format!("coincident nodes:     {want} (");
+        assert_eq!(text.contains(&line), want > 0, "{text}");
+    }
+}
+
 /// `two_squares_41_ascii.msh` with the header of its second surface's triangle block
 /// (`2 2 2 22`: dimension, entity, type, count) replaced, written to `dir`; and the line.
 fn two_squares_with_block_header(dir: &Path, header: &str) -> (PathBuf, usize) {
