@@ -276,8 +276,8 @@ fn text(i: &Info) -> String {
         wln!(
             s,
             "coincident nodes:     {} (at the position of another node: the elements there are \
-             not joined, a crack; merge them: Gmsh's Coherence Mesh, \
-             gmsh.model.mesh.removeDuplicateNodes())",
+             not joined, a crack unless meant, e.g. a contact interface; to join them: Gmsh's \
+             Coherence Mesh, gmsh.model.mesh.removeDuplicateNodes())",
             i.coincident_nodes
         );
     }

@@ -739,9 +739,12 @@ pub(crate) mod tests {
         );
     }
 
-    /// The directory's own configuration with its algorithms, horizons and meshes in another
-    /// order resumes it (its manifest and records unchanged); a shard's does not (its slice
-    /// depends on the order), nor does a reordering that also changes something else.
+    /// The directory's own configuration with its algorithms and horizons in another order
+    /// resumes it: a finished directory is left unchanged, a partial one is completed with
+    /// the records a sweep in the first order makes. Its meshes in another order do not (the
+    /// runs and the optimum are matched to a mesh by its place in the loaded list), nor does
+    /// a shard's reordering (its slice depends on the order), nor a reordering that also
+    /// changes something else.
     #[test]
     fn resume_takes_the_same_configuration_in_another_order() {
         let tmp = tempfile::tempdir().unwrap();
@@ -752,12 +755,38 @@ pub(crate) mod tests {
         let mut shuffled = m.clone();
         shuffled.spec.algos.reverse();
         shuffled.spec.horizons = vec![3, 1, 2];
-        shuffled.spec.meshes.reverse();
         assert!(shuffled.spec.is_reordering_of(&m.spec));
         let rep = run(&shuffled, &OK, &opts(tmp.path(), 1, true), &no, &mut |_| {}).unwrap();
         assert_eq!((rep.already, rep.done_now), (40, 0));
         assert_eq!(Manifest::read(tmp.path()).unwrap().spec, m.spec);
         assert_eq!(std::fs::read(tmp.path().join(RUNS_FILE)).unwrap(), before);
+
+        // A partial directory (its first 13 records) completed in the other order.
+        let partial = tmp.path().join("partial");
+        std::fs::create_dir(&partial).unwrap();
+        std::fs::copy(tmp.path().join(MANIFEST_FILE), partial.join(MANIFEST_FILE)).unwrap();
+        let cut = before
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| **c == b'\n')
+            .nth(12)
+            .unwrap()
+            .0
+            + 1;
+        std::fs::write(partial.join(RUNS_FILE), &before[..cut]).unwrap();
+        let rep = run(&shuffled, &OK, &opts(&partial, 2, true), &no, &mut |_| {}).unwrap();
+        assert_eq!((rep.already, rep.done_now), (13, 27));
+        assert_eq!(sorted(&partial), sorted(tmp.path()));
+        assert_eq!(Manifest::read(&partial).unwrap().spec, m.spec);
+
+        let mut meshes = m.clone();
+        meshes.spec.meshes.reverse();
+        meshes.optimum.reverse();
+        assert!(!meshes.spec.is_reordering_of(&m.spec));
+        let err = run(&meshes, &OK, &opts(tmp.path(), 1, true), &no, &mut |_| {}).unwrap_err();
+        assert!(err.to_string().contains("meshes"), "{err}");
+        assert_eq!(std::fs::read(tmp.path().join(RUNS_FILE)).unwrap(), before);
+
         let mut other = m.clone();
         other.spec.horizons = vec![3, 1, 1];
         assert!(!other.spec.is_reordering_of(&m.spec));
@@ -766,7 +795,7 @@ pub(crate) mod tests {
             err.to_string().contains("horizons [3, 1, 1] vs [1, 2, 3]"),
             "{err}"
         );
-        let shard = Some(Shard { index: 0, count: 2 });
+        let shard = Some(Shard { index: 1, count: 2 });
         let dir = tmp.path().join("shard");
         run(
             &manifest(shard),

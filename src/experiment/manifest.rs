@@ -97,17 +97,19 @@ impl SweepSpec {
             .unwrap_or(crate::quality::Rule::AllPairs)
     }
 
-    /// Whether this is `other` with its meshes, algorithms, horizons or budgets listed in
-    /// another order (`--algo optimum greedy selective --horizons 2,1` for a directory made
-    /// with `--algo selective greedy optimum --horizons 1,2`): the same runs, since a run's
-    /// seed derives from its configuration, not from its place in the run list.
+    /// Whether this is `other` with its algorithms, horizons or budgets listed in another
+    /// order (`--algo optimum greedy selective --horizons 2,1` for a directory made with
+    /// `--algo selective greedy optimum --horizons 1,2`): the same runs, since a run's seed
+    /// derives from its configuration, not from its place in the run list. The meshes must
+    /// come in the same order: the runs and the optimum are matched to a mesh by its place
+    /// in the list the command line loaded.
     pub fn is_reordering_of(&self, other: &SweepSpec) -> bool {
         fn permutation<T: PartialEq>(a: &[T], b: &[T]) -> bool {
             let count = |v: &[T], x: &T| v.iter().filter(|y| *y == x).count();
             a.len() == b.len() && a.iter().all(|x| count(a, x) == count(b, x))
         }
         let mut same = self.clone();
-        if !permutation(&self.meshes, &other.meshes)
+        if self.meshes != other.meshes
             || !permutation(&self.algos, &other.algos)
             || !permutation(&self.horizons, &other.horizons)
             || !permutation(&self.budgets, &other.budgets)
@@ -115,7 +117,6 @@ impl SweepSpec {
         {
             return false;
         }
-        same.meshes.clone_from(&other.meshes);
         same.algos.clone_from(&other.algos);
         same.horizons.clone_from(&other.horizons);
         same.budgets.clone_from(&other.budgets);

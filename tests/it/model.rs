@@ -514,11 +514,26 @@ fn skipped_elements_on_missing_nodes_are_refused() {
         let m = msh::read_bytes(name, &bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(m.num_triangles(), 1, "{name}");
     }
+    // MSH 2.2 binary writes tags as signed integers: a negative one is named as written.
+    for (tet, node, want) in [
+        (2, -5, "element 2 refers to node -5, which does not exist"),
+        (-2, 3, "bad element tag -2 (tags are positive)"),
+        (0, 3, "bad element tag 0 (tags are positive)"),
+    ] {
+        let err = msh::read_bytes("n.msh", &msh22_binary_tet_tagged(tet, node)).unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.contains("n.msh") && msg.contains(want), "{msg}");
+    }
 }
 
 /// MSH 2.2 binary: nodes 1..3 and one triangle (element 1), then a tetrahedron (element 2)
 /// on nodes 1, 2, 3 and `node`.
 fn msh22_binary_tet(node: u64) -> Vec<u8> {
+    msh22_binary_tet_tagged(2, node as i32)
+}
+
+/// [`msh22_binary_tet`] with the tetrahedron's tag and last node tag as written (`i32`).
+fn msh22_binary_tet_tagged(tet: i32, node: i32) -> Vec<u8> {
     let mut b = b"$MeshFormat\n2.2 1 8\n".to_vec();
     b.extend(1i32.to_le_bytes());
     b.extend(b"\n$EndMeshFormat\n$Nodes\n3\n");
@@ -532,7 +547,7 @@ fn msh22_binary_tet(node: u64) -> Vec<u8> {
     // Group header (type, count, number of tags), then tag, tags, nodes.
     for (etype, tag, nodes) in [
         (2i32, 1i32, vec![1i32, 2, 3]),
-        (4, 2, vec![1, 2, 3, node as i32]),
+        (4, tet, vec![1, 2, 3, node]),
     ] {
         for x in [etype, 1, 2, tag, 1, 1] {
             b.extend(x.to_le_bytes());

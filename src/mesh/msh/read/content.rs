@@ -265,35 +265,40 @@ pub(super) fn check_node(p: &Parser<'_>, map: &NodeMap, at: usize, tag: u64, n: 
 
 /// [`check_node`] for every node of a block of skipped binary elements: `count` records of
 /// `stride` bytes from byte offset `at0`, `tag(e)` and `node(e, k)` reading a record's tag
-/// and its `nn` node tags. One pass without error paths; the element at fault is looked for
-/// only when one is.
-#[allow(clippy::too_many_arguments)] // one record layout, read by the two closures
-pub(super) fn check_block_nodes(
+/// and its `nn` node tags as they are written (`T`: `u64` in MSH 4.1, `i32` in MSH 2.2),
+/// `key` giving the node map's key of a node tag (a negative tag none, as 0: no node has it).
+/// One pass without error paths; the element at fault is looked for only when one is.
+#[allow(clippy::too_many_arguments)] // one record layout, read by the closures
+pub(super) fn check_block_nodes<T: Copy + std::fmt::Display>(
     p: &Parser<'_>,
     map: &NodeMap,
     data: &[u8],
     at0: usize,
     stride: usize,
     nn: usize,
-    tag: impl Fn(&[u8]) -> u64,
-    node: impl Fn(&[u8], usize) -> u64,
+    tag: impl Fn(&[u8]) -> T,
+    node: impl Fn(&[u8], usize) -> T,
+    key: impl Fn(T) -> u64,
 ) -> Res<()> {
     let records = data.chunks_exact(stride);
     if records
         .clone()
-        .all(|e| (0..nn).all(|k| map.contains(node(e, k))))
+        .all(|e| (0..nn).all(|k| map.contains(key(node(e, k)))))
     {
         return Ok(());
     }
     for (i, e) in records.enumerate() {
         for k in 0..nn {
-            check_node(p, map, at0 + i * stride, tag(e), node(e, k))?;
+            let n = node(e, k);
+            if !map.contains(key(n)) {
+                return Err(p.err(at0 + i * stride, missing_node(tag(e), n)));
+            }
         }
     }
     unreachable!("a node that is not known was found")
 }
 
-fn missing_node(tag: u64, n: u64) -> String {
+fn missing_node(tag: impl std::fmt::Display, n: impl std::fmt::Display) -> String {
     format!("element {tag} refers to node {n}, which does not exist")
 }
 

@@ -242,11 +242,17 @@ pub(super) fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeM
                 }
             }
         } else {
-            // A negative node tag reads as 0, which no node has (node tags are positive).
-            let tag = |e: &[u8]| u64::try_from(i32_at(e, 0)).unwrap_or(0);
-            let node =
-                |e: &[u8], k: usize| u64::try_from(i32_at(e, 4 * (1 + ntags + k))).unwrap_or(0);
-            check_block_nodes(p, map, data, at0, stride, nn, tag, node)?;
+            // Refused as in a kept group: what the skipped elements name must exist too.
+            if let Some(i) = data.chunks_exact(stride).position(|e| i32_at(e, 0) <= 0) {
+                let tag = i32_at(&data[i * stride..], 0);
+                let at = at0 + i * stride;
+                return Err(p.err_bin(at, format!("bad element tag {tag} (tags are positive)")));
+            }
+            let tag = |e: &[u8]| i32_at(e, 0);
+            let node = |e: &[u8], k: usize| i32_at(e, 4 * (1 + ntags + k));
+            // A negative node tag is looked up as 0, which no node has (tags are positive).
+            let key = |v: i32| u64::try_from(v).unwrap_or(0);
+            check_block_nodes(p, map, data, at0, stride, nn, tag, node, key)?;
         }
         if !keep {
             c.skip(etype, n as u64, false);

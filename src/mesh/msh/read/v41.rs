@@ -532,7 +532,7 @@ fn element_block41_binary(
     } else {
         let tag = |e: &[u8]| u64_at(e, 0);
         let node = |e: &[u8], k: usize| u64_at(e, 8 + 8 * k);
-        check_block_nodes(p, map, data, at0, stride, nn, tag, node)?;
+        check_block_nodes(p, map, data, at0, stride, nn, tag, node, |v| v)?;
     }
     if !b.keep() {
         c.skip(b.etype, b.len, b.on_interface);
