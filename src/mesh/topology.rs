@@ -326,46 +326,24 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
     drop(half);
 
     // Components, and consistent orientation within each (flip[t] = reverse t).
-    let mut component = vec![NONE; nt];
-    let mut component_sizes = Vec::new();
-    let mut flip = vec![false; nt];
-    let mut stack = Vec::new();
-    for start in 0..nt {
-        if component[start] != NONE {
-            continue;
-        }
-        let c = component_sizes.len() as u32;
-        component[start] = c;
-        let mut size = 0u32;
-        stack.push(start as u32);
-        while let Some(t) = stack.pop() {
-            size += 1;
-            let tri = data.triangles[t as usize];
-            for i in 0..3 {
-                let u = neighbours[t as usize][i];
-                if u == NONE {
-                    continue;
-                }
-                // t traverses its side i as (tri[i] -> tri[i+1]); u must traverse it the other
-                // way once both flips are applied.
-                let other = data.triangles[u as usize];
-                let k = (0..3).find(|&k| other[k] == tri[i]).expect("shared vertex");
-                let same_direction = other[(k + 1) % 3] == tri[(i + 1) % 3];
-                let want = flip[t as usize] ^ same_direction;
-                if component[u as usize] == NONE {
-                    component[u as usize] = c;
-                    flip[u as usize] = want;
-                    stack.push(u);
-                } else if flip[u as usize] != want {
-                    return Err(MeshError::NonOrientable {
-                        surface: data.triangle_surface[t as usize],
-                        element: data.triangle_ids[u as usize],
-                    });
-                }
+    let (component, component_sizes, mut flip) =
+        match orient(&data.triangles, &neighbours, 0..nt as u32) {
+            Ok(o) => o,
+            Err(_) => {
+                // Which triangle the walk meets the conflict at depends on where it starts:
+                // walked again from the lowest element tags, the error names the same
+                // triangle whatever order the elements were read or stored in (`info`
+                // reads the file's order, `recombine` a spatial one).
+                let mut by_tag: Vec<u32> = (0..nt as u32).collect();
+                by_tag.sort_unstable_by_key(|&t| data.triangle_ids[t as usize]);
+                let t = orient(&data.triangles, &neighbours, by_tag.into_iter())
+                    .expect_err("a conflict does not depend on the walk");
+                return Err(MeshError::NonOrientable {
+                    surface: data.triangle_surface[t as usize],
+                    element: data.triangle_ids[t as usize],
+                });
             }
-        }
-        component_sizes.push(size);
-    }
+        };
     // Flip the smaller side of each component so the input orientation wins where it can.
     let mut flipped_in = vec![0u32; component_sizes.len()];
     for t in 0..nt {
@@ -408,6 +386,57 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             component_sizes,
         },
     })
+}
+
+/// Components of the dual graph `neighbours` of `triangles` and a consistent orientation
+/// within each (`flip[t]`: reverse `t`), walked depth first from each triangle of `starts`
+/// not reached yet, neighbours in side order. `Err(u)`: triangle `u` cannot be oriented
+/// consistently with the neighbour the walk reached it from (the surface is not orientable).
+#[allow(clippy::type_complexity)] // the three per-triangle arrays the walk fills
+fn orient(
+    triangles: &[[u32; 3]],
+    neighbours: &[[u32; 3]],
+    starts: impl Iterator<Item = u32>,
+) -> Result<(Vec<u32>, Vec<u32>, Vec<bool>), u32> {
+    let nt = triangles.len();
+    let mut component = vec![NONE; nt];
+    let mut component_sizes = Vec::new();
+    let mut flip = vec![false; nt];
+    let mut stack = Vec::new();
+    for start in starts {
+        if component[start as usize] != NONE {
+            continue;
+        }
+        let c = component_sizes.len() as u32;
+        component[start as usize] = c;
+        let mut size = 0u32;
+        stack.push(start);
+        while let Some(t) = stack.pop() {
+            size += 1;
+            let tri = triangles[t as usize];
+            for i in 0..3 {
+                let u = neighbours[t as usize][i];
+                if u == NONE {
+                    continue;
+                }
+                // t traverses its side i as (tri[i] -> tri[i+1]); u must traverse it the other
+                // way once both flips are applied.
+                let other = triangles[u as usize];
+                let k = (0..3).find(|&k| other[k] == tri[i]).expect("shared vertex");
+                let same_direction = other[(k + 1) % 3] == tri[(i + 1) % 3];
+                let want = flip[t as usize] ^ same_direction;
+                if component[u as usize] == NONE {
+                    component[u as usize] = c;
+                    flip[u as usize] = want;
+                    stack.push(u);
+                } else if flip[u as usize] != want {
+                    return Err(u);
+                }
+            }
+        }
+        component_sizes.push(size);
+    }
+    Ok((component, component_sizes, flip))
 }
 
 pub(super) fn sanity_check(mesh: &Mesh) -> Result<(), String> {
@@ -728,12 +757,40 @@ mod tests {
             triangles.push([a, d, b]);
         }
         let err = Mesh::new(MeshData {
-            vertices,
-            triangles,
+            vertices: vertices.clone(),
+            triangles: triangles.clone(),
             ..MeshData::default()
         })
         .unwrap_err();
         assert!(matches!(err, MeshError::NonOrientable { .. }), "{err}");
+        // The triangle named does not depend on the order the elements come in (`info`
+        // keeps the file's, `recombine` sorts them spatially): every rotation and the
+        // reversal of the element list, tags kept, name the same one.
+        let named = |order: &[usize]| {
+            let err = Mesh::new(MeshData {
+                vertices: vertices.clone(),
+                triangles: order.iter().map(|&i| triangles[i]).collect(),
+                triangle_ids: order.iter().map(|&i| 10 + i as u64).collect(),
+                triangle_surface: vec![1; order.len()],
+                ..MeshData::default()
+            })
+            .unwrap_err();
+            match err {
+                MeshError::NonOrientable { element, .. } => element,
+                e => panic!("{e}"),
+            }
+        };
+        let mut order: Vec<usize> = (0..triangles.len()).collect();
+        let first = named(&order);
+        let mut seen = vec![];
+        for _ in 0..order.len() {
+            order.rotate_left(1);
+            seen.push(named(&order));
+            order.reverse();
+            seen.push(named(&order));
+            order.reverse();
+        }
+        assert!(seen.iter().all(|&e| e == first), "{first} vs {seen:?}");
     }
 
     #[test]
