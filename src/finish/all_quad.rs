@@ -73,7 +73,8 @@ pub(crate) fn split(
         data.triangle_surface
             .push(mesh.triangle_surface[b as usize]);
         if let Some(model) = data.model.as_deref_mut() {
-            split_model_edge(model, p, q, m, mesh.triangle_surface[b as usize]);
+            // A side all-quad splits is used by one element: a boundary.
+            split_model_edge(model, [p, q], m, mesh.triangle_surface[b as usize], true);
         }
         let nb = mesh.topology.neighbours[b as usize];
         half_pairs.push((b, nb[(side + 2) % 3]));
@@ -155,35 +156,85 @@ pub(crate) fn split(
 }
 
 /// Splits the model's line element on side `p`-`q` (if any) at the new node `m`, and
-/// classifies `m` on that curve, or on surface `surface` when no line element lies there.
+/// classifies `m` on the curve the side lies on, or on surface `surface` when it lies on none.
+/// `edge` says whether the side is one where a curve must lie: used by one element, or by
+/// elements of two surfaces or by three or more.
+///
+/// Gmsh saves line elements only for curves in physical groups (unless `Mesh.SaveAll`), but
+/// classifies every node: without a line element, the curve is read off the ends' entities
+/// ([`curve_of_side`]). A curve node on a surface made Gmsh's `recombine()` drop it and open
+/// a hole in the mesh. On a curve, `m` gets the mean of its ends' parameters where both have
+/// one (the side is a segment of the curve between them).
 pub(crate) fn split_model_edge(
     model: &mut crate::mesh::msh::Model,
-    p: u32,
-    q: u32,
+    [p, q]: [u32; 2],
     m: u32,
     surface: i32,
+    edge: bool,
 ) {
-    let mut entity = (2u8, surface);
-    let mut halves = None;
-    for (i, e) in model.elements.iter().enumerate() {
-        if e.dim == 1 && e.nodes.len() == 2 && (e.nodes == [p, q] || e.nodes == [q, p]) {
-            entity = (1, e.entity);
-            halves = Some(i);
-            break;
-        }
-    }
-    if let Some(i) = halves {
+    let line = model
+        .elements
+        .iter()
+        .position(|e| e.dim == 1 && e.nodes.len() == 2 && (e.nodes == [p, q] || e.nodes == [q, p]));
+    let curve = match line {
+        Some(i) => Some(model.elements[i].entity),
+        None => curve_of_side(model, [p, q], edge),
+    };
+    if let Some(i) = line {
         let [a, b] = [model.elements[i].nodes[0], model.elements[i].nodes[1]];
         model.elements[i].nodes = vec![a, m];
         let mut second = model.elements[i].clone();
         second.nodes = vec![m, b];
         model.elements.insert(i + 1, second);
     }
+    let entity = curve.map_or((2u8, surface), |c| (1, c));
+    let param = curve.and_then(|_| {
+        let on = |v: u32| model.node_entity.get(v as usize).copied().flatten();
+        let u = |v: u32| model.node_param.get(v as usize).copied().flatten();
+        match (u(p), u(q)) {
+            (Some(a), Some(b)) if on(p) == Some(entity) && on(q) == Some(entity) => {
+                Some([0.5 * (a[0] + b[0]), 0.0, 0.0])
+            }
+            _ => None,
+        }
+    });
     if !model.node_entity.is_empty() {
         model.node_entity.push(Some(entity));
     }
     if !model.node_param.is_empty() {
-        model.node_param.push(None);
+        model.node_param.push(param);
+    }
+}
+
+/// The curve that side `p`-`q` lies on, read off the entities its ends are classified on
+/// (no line element lies on it): both on one curve; or one on a curve and the other on a point
+/// that bounds it (`$Entities` of MSH 4.1 give the bounding points; without them, only for a
+/// side where a curve must lie, `edge`); or, for such a side, both on points that bound exactly
+/// one curve together. `None` otherwise (the side is inside a surface).
+fn curve_of_side(model: &crate::mesh::msh::Model, [p, q]: [u32; 2], edge: bool) -> Option<i32> {
+    let on = |v: u32| model.node_entity.get(v as usize).copied().flatten();
+    let bounds = |c: i32, t: i32| {
+        model
+            .entity(1, c)
+            .is_some_and(|e| e.bounding.iter().any(|&b| b.abs() == t.abs()))
+    };
+    let topology = |c: i32| model.entity(1, c).is_some_and(|e| !e.bounding.is_empty());
+    match (on(p)?, on(q)?) {
+        ((1, a), (1, b)) if a == b => Some(a),
+        ((1, c), (0, t)) | ((0, t), (1, c)) => {
+            (bounds(c, t) || (edge && !topology(c))).then_some(c)
+        }
+        ((0, s), (0, t)) if edge && s != t => {
+            let mut curves = model
+                .entities
+                .iter()
+                .filter(|e| e.dim == 1 && bounds(e.tag, s) && bounds(e.tag, t));
+            match (curves.next(), curves.next()) {
+                (Some(c), None) => Some(c.tag),
+                _ => None,
+            }
+        }
+        _ => None,
     }
 }
 

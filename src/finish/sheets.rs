@@ -113,9 +113,14 @@ pub(crate) fn refine(
     };
 
     let mut stats = SheetStats::default();
-    // Sides with a midpoint, in the order traced, with the surface of the element traced from.
+    // Sides with a midpoint, in the order traced, with the surface of the element traced from
+    // and whether a curve must lie on the side (see `split_model_edge`).
     let mut mids: HashMap<[u32; 2], u32> = HashMap::new();
-    let mut mid_order: Vec<([u32; 2], i32)> = Vec::new();
+    let mut mid_order: Vec<([u32; 2], i32, bool)> = Vec::new();
+    let curve_side = |e: usize| match on_edge[e][..] {
+        [x, y] => mesh.triangle_surface[x as usize] != mesh.triangle_surface[y as usize],
+        _ => true,
+    };
     let first_vertex = mesh.vertices.len() as u32;
     let mut cut = vec![false; table.len()];
     let mut side_done = vec![[false; 3]; nt];
@@ -142,7 +147,14 @@ pub(crate) fn refine(
                 match mids.entry(key(a, b)) {
                     Entry::Vacant(v) => {
                         v.insert(first_vertex + mid_order.len() as u32);
-                        mid_order.push((key(a, b), mesh.triangle_surface[cur as usize]));
+                        let s = side_of(mesh.triangles[cur as usize], a, b)
+                            .expect("the sheet's side is a side of its triangle");
+                        let e = topo.triangle_edges[cur as usize][s] as usize;
+                        mid_order.push((
+                            key(a, b),
+                            mesh.triangle_surface[cur as usize],
+                            curve_side(e),
+                        ));
                     }
                     // Reached again (a sheet through a side shared by three or more
                     // elements can come back to it): whoever gave it its midpoint went on
@@ -205,11 +217,11 @@ pub(crate) fn refine(
     let mean = |ps: &[[f64; 3]]| -> [f64; 3] {
         std::array::from_fn(|d| ps.iter().map(|p| p[d]).sum::<f64>() / ps.len() as f64)
     };
-    for &([a, b], surface) in &mid_order {
+    for &([a, b], surface, edge) in &mid_order {
         let p = mean(&[at(&data, a), at(&data, b)]);
         let m = add_node(&mut data, &mut next_node, p);
         if let Some(model) = data.model.as_deref_mut() {
-            super::all_quad::split_model_edge(model, a, b, m, surface);
+            super::all_quad::split_model_edge(model, [a, b], m, surface, edge);
         }
     }
     let mid = |a: u32, b: u32| mids[&key(a, b)];

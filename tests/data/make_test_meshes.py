@@ -186,3 +186,44 @@ gmsh.model.mesh.setRecombine(2, b)
 mesh(0.22)
 write("mixed_odd_41_ascii.msh", 4.1, 0)
 gmsh.finalize()
+
+# The box of tetrahedra again, finer (interior nodes), unpartitioned and in two partitions:
+# MSH 4.1 puts the interior nodes on partition volumes, which the writer must give back to
+# the box's volume (tests/it/model.rs).
+start("box_fine")
+gmsh.model.occ.addBox(0, 0, 0, 1, 1, 0.5)
+mesh(0.25, dim=3)
+write("box_fine_41_ascii.msh", 4.1, 0)
+gmsh.model.mesh.partition(2)
+write("box_fine_parts_41_ascii.msh", 4.1, 0)
+gmsh.finalize()
+
+# Models whose curves have no line elements (only physical surfaces: Gmsh saves no line
+# elements, but classifies the curve nodes), with odd triangle counts so that all-quad adds
+# nodes on curve sides (tests/it/model.rs): a square with parametric coordinates (a boundary
+# split), and a disk inside a square, both surfaces odd (sheets across the interface circle).
+start("square_nolines")
+occ = gmsh.model.occ
+occ.addRectangle(0, 0, 0, 1, 1)
+occ.synchronize()
+gmsh.model.mesh.setTransfiniteCurve(1, 8)
+gmsh.model.addPhysicalGroup(2, [1], name="plate")
+mesh(0.1)
+assert len(gmsh.model.mesh.getElementsByType(2)[0]) % 2 == 1
+gmsh.option.setNumber("Mesh.SaveParametric", 1)
+write("square_nolines_41_ascii.msh", 4.1, 0)
+gmsh.option.setNumber("Mesh.SaveParametric", 0)
+gmsh.finalize()
+
+start("disk_nolines")
+occ = gmsh.model.occ
+occ.fragment([(2, occ.addRectangle(0, 0, 0, 1, 1))], [(2, occ.addDisk(0.5, 0.5, 0, 0.25, 0.25))])
+occ.synchronize()
+for _, s in gmsh.model.getEntities(2):
+    inner = abs(occ.getMass(2, s) - 3.14159265 * 0.0625) < 1e-3
+    gmsh.model.addPhysicalGroup(2, [s], name="disk" if inner else "ring")
+mesh(0.11)
+counts = [len(gmsh.model.mesh.getElements(2, s)[1][0]) for _, s in gmsh.model.getEntities(2)]
+assert all(n % 2 == 1 for n in counts), counts
+write("disk_nolines_41_ascii.msh", 4.1, 0)
+gmsh.finalize()

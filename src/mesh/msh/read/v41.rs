@@ -15,8 +15,8 @@ use crate::mesh::msh::model::Entity;
 /// The `$PartitionedEntities` section of MSH 4.1 (a mesh split into partitions, whose
 /// elements are on new entities, one per partition and model entity): the parent of each
 /// partition surface, into `c.parents`, or, for a surface cut from a volume (an interface
-/// between volume partitions), its tag into `c.interfaces`. Reads up to the surfaces
-/// (points and curves are read past); the caller skips the rest.
+/// between volume partitions), its tag into `c.interfaces`; the parent of every partition
+/// entity (volumes included: their nodes go to the parent volume) into `c.model.parents`.
 pub(super) fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     let s = "$PartitionedEntities";
     p.binary_data_start();
@@ -30,7 +30,7 @@ pub(super) fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
         .iter()
         .map(|what| p.size_t(s, &|| format!("the number of partition {what}")))
         .collect::<Res<_>>()?;
-    for (dim, &count) in counts.iter().take(3).enumerate() {
+    for (dim, &count) in counts.iter().enumerate() {
         for i in 0..count {
             let what = || format!("partition entity {} of dimension {dim}", i + 1);
             let tag = p.int_field(s, &what)?;
