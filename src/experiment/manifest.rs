@@ -269,10 +269,29 @@ impl Machine {
     }
 }
 
+/// The first entry `spec` lists twice, named for a message: a mesh (by name or content),
+/// an algorithm, a horizon, a budget or a time budget. A sweep refuses each of these.
+fn repeated_entry(s: &SweepSpec) -> Option<String> {
+    fn first_repeat<T: PartialEq>(items: &[T]) -> Option<&T> {
+        (items.iter().enumerate()).find_map(|(i, x)| items[..i].contains(x).then_some(x))
+    }
+    let meshes = s.meshes.iter().enumerate().find_map(|(i, m)| {
+        (s.meshes[..i].iter())
+            .any(|o| o.name == m.name || o.hash == m.hash)
+            .then(|| format!("mesh {:?}", m.name))
+    });
+    meshes
+        .or_else(|| first_repeat(&s.algos).map(|a| format!("algorithm {a:?}")))
+        .or_else(|| first_repeat(&s.horizons).map(|h| format!("horizon {h}")))
+        .or_else(|| first_repeat(&s.budgets).map(|b| format!("budget {b}")))
+        .or_else(|| first_repeat(&s.time_budgets).map(|t| format!("time budget {} s", t.seconds())))
+}
+
 impl Manifest {
     /// Reads `dir/manifest.json`.
     pub fn read(dir: &Path) -> Result<Manifest, ExperimentError> {
         let path = dir.join(MANIFEST_FILE);
+        super::store::refuse_irregular(&path)?;
         let text = std::fs::read_to_string(&path).map_err(|e| ExperimentError::io(&path, e))?;
         let m: Manifest = serde_json::from_str(&text).map_err(|e| ExperimentError::Corrupt {
             path: path.clone(),
@@ -295,6 +314,10 @@ impl Manifest {
             .find(|t| !t.is_valid());
         let why = if let Some(t) = bad_time {
             Some(format!("time budget {} s is out of range", t.seconds()))
+        } else if let Some(repeat) = repeated_entry(s) {
+            // Jobs are keyed by mesh, algorithm, horizon and budget: a repeat made merge
+            // look a key up twice (a panic) where a sweep refuses the repeat.
+            Some(format!("{repeat} is listed twice"))
         } else if let Err(e) = size {
             Some(match e {
                 SizeError::Runs { total, .. } => format!(

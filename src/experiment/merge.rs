@@ -51,6 +51,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
             };
             return Err(ExperimentError::Merge(format!("{}: {why}", p.display())));
         }
+        super::store::refuse_irregular(&p.join(MANIFEST_FILE))?;
         if !p.join(MANIFEST_FILE).is_file() {
             return Err(ExperimentError::Merge(format!(
                 "{}: not a sweep's results directory (no {MANIFEST_FILE})",

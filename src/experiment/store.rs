@@ -31,8 +31,30 @@ pub struct Loaded {
     pub torn_bytes: u64,
 }
 
-/// Reads a run log. A missing file is an empty log.
+/// Refuses `path` when it exists and is not a regular file (a directory, a FIFO, which a read
+/// would wait on forever, or a device such as `/dev/zero`, read until memory runs out),
+/// after following links.
+pub fn refuse_irregular(path: &Path) -> Result<(), ExperimentError> {
+    match std::fs::metadata(path) {
+        Ok(meta) if !meta.is_file() => {
+            let kind = if meta.is_dir() {
+                "a directory"
+            } else {
+                "a FIFO, socket or device"
+            };
+            Err(ExperimentError::Corrupt {
+                path: path.to_path_buf(),
+                message: format!("is {kind}, not a regular file"),
+            })
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Reads a run log. A missing file is an empty log; one that is not a regular file is
+/// refused ([`refuse_irregular`]).
 pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
+    refuse_irregular(path)?;
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),

@@ -127,6 +127,7 @@ impl Results {
         if loaded.records.is_empty() {
             return Err(ReportError::NoRuns { path });
         }
+        store::refuse_irregular(&dir.join(manifest::MANIFEST_FILE))?;
         let manifest = if dir.join(manifest::MANIFEST_FILE).is_file() {
             Some(manifest::Manifest::read(dir)?)
         } else {

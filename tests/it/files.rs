@@ -998,3 +998,107 @@ fn fuzz_a_huge_time_is_plotted() {
     let o = run_limited(tmp.path(), "true", &["report", "d", "--no-pictures"], 30);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// A manifest that lists a horizon, an algorithm or a mesh twice (a sweep refuses each) is
+/// refused by `merge`, `report` and `sweep --resume` with exit 3, naming the repeat (`merge`
+/// panicked: "checked: none missing", a review's finding). A `runs.jsonl` or `manifest.json`
+/// that is not a regular file (a directory; a link to a device) is refused with exit 3 by
+/// `merge`, `report` and `--resume` (a directory gave exit 1, a FIFO made them wait forever, and
+/// `/dev/zero` was read until memory ran out).
+#[test]
+fn repeated_manifest_entries_and_irregular_files_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = small_sweep(tmp.path(), "d", &["--no-report"]);
+    let manifest = std::fs::read_to_string(d.join("manifest.json")).unwrap();
+    let resume = [
+        "sweep",
+        "--mesh",
+        "sphere",
+        "--algo",
+        "selective",
+        "greedy",
+        "--horizons",
+        "1,2",
+        "--runs",
+        "3",
+        "--backend",
+        "cpu",
+        "--out",
+        "d",
+        "-q",
+        "--resume",
+    ];
+    type Edit = fn(&mut serde_json::Value);
+    let edits: [(&str, Edit); 3] = [
+        ("horizon 2 is listed twice", |m| {
+            m["spec"]["horizons"] = serde_json::json!([1, 2, 2])
+        }),
+        ("algorithm \"greedy\" is listed twice", |m| {
+            m["spec"]["algos"] = serde_json::json!(["selective", "greedy", "greedy"])
+        }),
+        ("mesh \"sphere\" is listed twice", |m| {
+            let mesh = m["spec"]["meshes"][0].clone();
+            m["spec"]["meshes"].as_array_mut().unwrap().push(mesh);
+        }),
+    ];
+    for (why, edit) in edits {
+        let mut m: serde_json::Value = serde_json::from_str(&manifest).unwrap();
+        edit(&mut m);
+        std::fs::write(d.join("manifest.json"), m.to_string()).unwrap();
+        for cmd in [&["merge", "d", "--out", "m"][..], &["report", "d"], &resume] {
+            let o = run_in(tmp.path(), cmd);
+            let e = stderr(&o);
+            assert_eq!(o.status.code(), Some(3), "{cmd:?} {why}: {e}");
+            assert!(
+                e.contains(why) && e.contains("manifest.json"),
+                "{cmd:?}: {e}"
+            );
+        }
+    }
+    std::fs::write(d.join("manifest.json"), &manifest).unwrap();
+    let runs = d.join("runs.jsonl");
+    let kept = std::fs::read(&runs).unwrap();
+    for (file, why) in [
+        ("runs.jsonl", "is a directory, not a regular file"),
+        ("manifest.json", "is a directory, not a regular file"),
+        (
+            "runs.jsonl",
+            "is a FIFO, socket or device, not a regular file",
+        ),
+        (
+            "manifest.json",
+            "is a FIFO, socket or device, not a regular file",
+        ),
+    ] {
+        let path = d.join(file);
+        let kept = std::fs::read(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        if why.contains("directory") {
+            std::fs::create_dir(&path).unwrap();
+        } else {
+            std::os::unix::fs::symlink("/dev/null", &path).unwrap();
+        }
+        for cmd in [&["merge", "d", "--out", "m"][..], &["report", "d"], &resume] {
+            let o = run_in(tmp.path(), cmd);
+            let e = stderr(&o);
+            if cmd[0] == "report" && file == "runs.jsonl" {
+                // report names a missing log its own way ("no runs.jsonl").
+                assert_eq!(o.status.code(), Some(3), "{cmd:?} {file}: {e}");
+                continue;
+            }
+            assert_eq!(o.status.code(), Some(3), "{cmd:?} {file}: {e}");
+            assert!(
+                e.contains(&format!("{file}: corrupt: {why}")),
+                "{cmd:?}: {e}"
+            );
+        }
+        if path.is_dir() {
+            std::fs::remove_dir(&path).unwrap();
+        } else {
+            std::fs::remove_file(&path).unwrap();
+        }
+        std::fs::write(&path, kept).unwrap();
+    }
+    assert_eq!(std::fs::read(&runs).unwrap(), kept);
+    assert!(!tmp.path().join("m/runs.jsonl").exists());
+}
