@@ -430,6 +430,7 @@ pub const ACROSS_CSV: &str = "across_meshes.csv";
 /// not a file to delete.
 pub fn report_files(dir: &Path) -> Result<Vec<String>, ExperimentError> {
     let path = dir.join(REPORT_FILES);
+    super::store::refuse_irregular(&path)?;
     let text = match std::fs::read_to_string(&path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),

@@ -168,6 +168,8 @@ pub fn cached_optimum(
 ) -> Result<OptimumEntry, ExperimentError> {
     let dir = out.join(OPTIMUM_CACHE_DIR);
     let path = dir.join(format!("{}.json", entry.hash));
+    // A FIFO there would block the read forever (and no cache could be written over it).
+    super::store::refuse_irregular(&path)?;
     let eta = eta_hash(&table.eta);
     let text = (!recompute)
         .then(|| std::fs::read_to_string(&path).ok())

@@ -178,7 +178,7 @@ pub(crate) fn split_model_edge(
         .position(|e| e.dim == 1 && e.nodes.len() == 2 && (e.nodes == [p, q] || e.nodes == [q, p]));
     let curve = match line {
         Some(i) => Some(model.elements[i].entity),
-        None => curve_of_side(model, [p, q], edge),
+        None => curve_of_side(model, [p, q], surface, edge),
     };
     if let Some(i) = line {
         let [a, b] = [model.elements[i].nodes[0], model.elements[i].nodes[1]];
@@ -206,12 +206,22 @@ pub(crate) fn split_model_edge(
     }
 }
 
-/// The curve that side `p`-`q` lies on, read off the entities its ends are classified on
-/// (no line element lies on it): both on one curve; or one on a curve and the other on a point
-/// that bounds it (`$Entities` of MSH 4.1 give the bounding points; without them, only for a
-/// side where a curve must lie, `edge`); or, for such a side, both on points that bound exactly
-/// one curve together. `None` otherwise (the side is inside a surface).
-fn curve_of_side(model: &crate::mesh::msh::Model, [p, q]: [u32; 2], edge: bool) -> Option<i32> {
+/// The curve that side `p`-`q` (of an element of `surface`) lies on, read off the entities
+/// its ends are classified on, when no line element lies on it: both on one curve; one on a
+/// curve and the other on a point that bounds it (MSH 4.1's `$Entities` give the bounding
+/// points; without them, any point); or both on the two points that bound exactly one curve.
+/// Only for a side where a curve must lie (`edge`), or, inside one surface, for a curve
+/// embedded in it (not among its bounding curves; none is known without `$Entities`): a side
+/// of one surface's interior whose ends are on a curve bounding it is a chord across the
+/// surface (a triangle with its three corners on the curve has one). And never for a curve
+/// whose segments the file gives as line elements: a side without one is not a segment.
+/// `None` otherwise: the node stays on the surface.
+fn curve_of_side(
+    model: &crate::mesh::msh::Model,
+    [p, q]: [u32; 2],
+    surface: i32,
+    edge: bool,
+) -> Option<i32> {
     let on = |v: u32| model.node_entity.get(v as usize).copied().flatten();
     let bounds = |c: i32, t: i32| {
         model
@@ -219,23 +229,28 @@ fn curve_of_side(model: &crate::mesh::msh::Model, [p, q]: [u32; 2], edge: bool) 
             .is_some_and(|e| e.bounding.iter().any(|&b| b.abs() == t.abs()))
     };
     let topology = |c: i32| model.entity(1, c).is_some_and(|e| !e.bounding.is_empty());
-    match (on(p)?, on(q)?) {
-        ((1, a), (1, b)) if a == b => Some(a),
-        ((1, c), (0, t)) | ((0, t), (1, c)) => {
-            (bounds(c, t) || (edge && !topology(c))).then_some(c)
-        }
-        ((0, s), (0, t)) if edge && s != t => {
-            let mut curves = model
-                .entities
-                .iter()
+    let curve = match (on(p)?, on(q)?) {
+        ((1, a), (1, b)) if a == b => a,
+        ((1, c), (0, t)) | ((0, t), (1, c)) if bounds(c, t) || !topology(c) => c,
+        ((0, s), (0, t)) if s != t => {
+            let mut curves = (model.entities.iter())
                 .filter(|e| e.dim == 1 && bounds(e.tag, s) && bounds(e.tag, t));
             match (curves.next(), curves.next()) {
-                (Some(c), None) => Some(c.tag),
-                _ => None,
+                (Some(c), None) => c.tag,
+                _ => return None,
             }
         }
-        _ => None,
+        _ => return None,
+    };
+    if (model.elements.iter()).any(|e| e.dim == 1 && e.entity == curve) {
+        return None;
     }
+    let embedded = || {
+        model.entity(2, surface).is_some_and(|s| {
+            !s.bounding.is_empty() && !s.bounding.iter().any(|b| b.abs() == curve.abs())
+        })
+    };
+    (edge || embedded()).then_some(curve)
 }
 
 /// `mesh`'s data, to add nodes and elements to (split sides, sheets): the input quads keep

@@ -1004,7 +1004,8 @@ fn fuzz_a_huge_time_is_plotted() {
 /// panicked: "checked: none missing", a review's finding). A `runs.jsonl` or `manifest.json`
 /// that is not a regular file (a directory; a link to a device) is refused with exit 3 by
 /// `merge`, `report` and `--resume` (a directory gave exit 1, a FIFO made them wait forever, and
-/// `/dev/zero` was read until memory ran out).
+/// `/dev/zero` was read until memory ran out); so is such an optimum cache file (`--resume`)
+/// or `report-files.txt` (`report`).
 #[test]
 fn repeated_manifest_entries_and_irregular_files_are_refused() {
     let tmp = tempfile::tempdir().unwrap();
@@ -1101,4 +1102,33 @@ fn repeated_manifest_entries_and_irregular_files_are_refused() {
     }
     assert_eq!(std::fs::read(&runs).unwrap(), kept);
     assert!(!tmp.path().join("m/runs.jsonl").exists());
+    // The optimum cache (read by --resume) and the report's file list (read by report)
+    // likewise: a FIFO there made them wait forever.
+    let cache = std::fs::read_dir(d.join("optimum-cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "json"))
+        .expect("an optimum cache file");
+    for (path, cmd) in [
+        (cache, &resume[..]),
+        (
+            d.join("report-files.txt"),
+            &["report", "d", "--no-pictures"][..],
+        ),
+    ] {
+        let kept = std::fs::read(&path).ok();
+        let _ = std::fs::remove_file(&path);
+        std::os::unix::fs::symlink("/dev/null", &path).unwrap();
+        let o = run_in(tmp.path(), cmd);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(3), "{cmd:?}: {e}");
+        assert!(
+            e.contains("is a FIFO, socket or device, not a regular file"),
+            "{cmd:?}: {e}"
+        );
+        std::fs::remove_file(&path).unwrap();
+        if let Some(kept) = kept {
+            std::fs::write(&path, kept).unwrap();
+        }
+    }
 }

@@ -432,18 +432,30 @@ print(json.dumps(out))
 /// a side between two surfaces (sheets across the disk's circle) is classified on the curve of
 /// the side's ends, with the mean of their parameters, as Gmsh reads the file; every other new
 /// node on its surface. Put on the surface before (a review's finding), a split node made
-/// Gmsh's `recombine()` drop it and open a hole; the area is kept now.
+/// Gmsh's `recombine()` drop it and open a hole; the area is kept now. A disk of six nodes,
+/// all on its circle, with a triangle inside (its sides are chords): the sheets' midpoints of
+/// the chords stay on the surface, with or without the circle's line elements (a second
+/// review's finding: they went on the circle).
 #[test]
 fn all_quad_puts_new_nodes_on_curve_sides_on_their_curves() {
     if !gmsh_available() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
+    for lines in [false, true] {
+        std::fs::write(dir.path().join(format!("hex{lines}.msh")), hexagon(lines)).unwrap();
+    }
     for (name, params) in [
-        ("square_nolines_41_ascii.msh", true),
-        ("disk_nolines_41_ascii.msh", false),
+        ("square_nolines_41_ascii.msh", Some(true)),
+        ("disk_nolines_41_ascii.msh", Some(false)),
+        ("hexfalse.msh", None),
+        ("hextrue.msh", None),
     ] {
-        let input = data(name);
+        let input = if name.starts_with("hex") {
+            dir.path().join(name)
+        } else {
+            data(name)
+        };
         let out = dir.path().join(format!("{name}.aq.msh"));
         crate::util::run_ok(
             dir.path(),
@@ -464,11 +476,40 @@ fn all_quad_puts_new_nodes_on_curve_sides_on_their_curves() {
         assert!(v["on_curve_sides"].as_u64().unwrap() >= 1, "{name}: {v}");
         assert_eq!(v["wrong"], serde_json::json!([]), "{name}: {v}");
         assert_eq!(v["wrong_params"], serde_json::json!([]), "{name}: {v}");
-        assert_eq!(v["params"].as_u64().unwrap() >= 1, params, "{name}: {v}");
+        if let Some(params) = params {
+            assert_eq!(v["params"].as_u64().unwrap() >= 1, params, "{name}: {v}");
+        }
         let r = gmsh_reads(&out, "recombine");
         let area = |i: usize| r["area"][i][0].as_f64().unwrap();
         assert!(relative(area(0), area(1)) < 1e-9, "{name}: {}", r["area"]);
     }
+}
+
+/// A MSH 4.1 disk: six nodes on its circle (curve 1, from and to point 1, with parameters),
+/// three ears and a triangle inside, and the circle's six line elements when `lines`; only
+/// the surface is in a physical group.
+fn hexagon(lines: bool) -> String {
+    let mut s = String::from(
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 1 \"disk\"\n\
+         $EndPhysicalNames\n$Entities\n1 1 1 0\n1 1 0 0 0\n1 -1 -1 0 1 1 0 0 2 1 -1\n\
+         1 -1 -1 0 1 1 0 1 1 1 1\n$EndEntities\n$Nodes\n2 6 1 6\n0 1 0 1\n1\n1 0 0\n\
+         1 1 1 5\n2\n3\n4\n5\n6\n",
+    );
+    for k in 1..6 {
+        let a = k as f64 * std::f64::consts::PI / 3.0;
+        s += &format!("{} {} 0 {a}\n", a.cos(), a.sin());
+    }
+    s += "$EndNodes\n$Elements\n";
+    if lines {
+        s += "2 10 1 10\n1 1 1 6\n";
+        for k in 1..=6 {
+            s += &format!("{} {k} {}\n", k + 4, k % 6 + 1);
+        }
+    } else {
+        s += "1 4 1 4\n";
+    }
+    s += "2 1 2 4\n1 1 2 3\n2 3 4 5\n3 5 6 1\n4 1 3 5\n$EndElements\n";
+    s
 }
 
 /// meshio reads our file with its physical groups: cells by type and the group names.
