@@ -10,9 +10,9 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// A small sweep (sphere, selective h = 1, 2 and greedy) into `dir/name`, with its report.
-fn small_sweep(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
-    let mut args = vec![
+/// The arguments of a small sweep (sphere, selective h = 1, 2 and greedy) into `name`.
+fn small_sweep_args(name: &str) -> Vec<&str> {
+    vec![
         "sweep",
         "--mesh",
         "sphere",
@@ -28,7 +28,12 @@ fn small_sweep(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
         "--out",
         name,
         "-q",
-    ];
+    ]
+}
+
+/// A small sweep ([`small_sweep_args`]) into `dir/name`, with its report.
+fn small_sweep(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
+    let mut args = small_sweep_args(name);
     args.extend_from_slice(extra);
     let o = run_in(dir, &args);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -1011,24 +1016,8 @@ fn repeated_manifest_entries_and_irregular_files_are_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let d = small_sweep(tmp.path(), "d", &["--no-report"]);
     let manifest = std::fs::read_to_string(d.join("manifest.json")).unwrap();
-    let resume = [
-        "sweep",
-        "--mesh",
-        "sphere",
-        "--algo",
-        "selective",
-        "greedy",
-        "--horizons",
-        "1,2",
-        "--runs",
-        "3",
-        "--backend",
-        "cpu",
-        "--out",
-        "d",
-        "-q",
-        "--resume",
-    ];
+    let mut resume = small_sweep_args("d");
+    resume.push("--resume");
     type Edit = fn(&mut serde_json::Value);
     let edits: [(&str, Edit); 3] = [
         ("horizon 2 is listed twice", |m| {
