@@ -41,6 +41,10 @@ pub enum MeshError {
         log10_height: f64,
     },
     #[error(
+        "quad {element} is degenerate (its area is zero to within rounding: four collinear nodes, or two halves folded onto each other): nodes {nodes:?}"
+    )]
+    DegenerateQuad { element: u64, nodes: [u64; 4] },
+    #[error(
         "element tag {tag} is given to two elements (tags must be unique: Gmsh would keep only the last one)"
     )]
     DuplicateElementTag { tag: u64 },

@@ -278,6 +278,14 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             });
         }
     }
+    for (q, quad) in data.quads.iter().enumerate() {
+        if quad_is_flat(quad.map(|v| data.vertices[v as usize])) {
+            return Err(MeshError::DegenerateQuad {
+                element: data.quad_ids[q],
+                nodes: quad.map(|v| data.vertex_ids[v as usize]),
+            });
+        }
+    }
     let half = HalfEdges::new(nv, &data.triangles, &data.quads)?;
     if let Some((first, second)) = half.duplicate_triangle(&data.triangles) {
         return Err(MeshError::DuplicateTriangle {
@@ -536,6 +544,21 @@ pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 
+/// An input quad whose vector area (half the cross product of its diagonals) is zero to
+/// within rounding, relative to its longest diagonal, as a triangle's is tested: four
+/// collinear nodes, or a bow tie whose halves cancel. A quad with a straight or reflex
+/// corner has an area and is read (its eta is 0, which `info` counts as poor).
+fn quad_is_flat([a, b, c, d]: [[f64; 3]; 4]) -> bool {
+    let (mut u, mut w) = (sub(c, a), sub(d, b));
+    let m = u.iter().chain(&w).fold(0.0f64, |m, x| m.max(x.abs()));
+    if m > 0.0 && m.is_finite() {
+        u = u.map(|x| x / m);
+        w = w.map(|x| x / m);
+    }
+    let scale = dot(u, u).max(dot(w, w));
+    norm(cross(u, w)) <= 1e-14 * scale || scale == 0.0
+}
+
 /// log10 of the smallest height of triangle `abc` over its longest edge, without
 /// under- or overflow (a triangle 1e200 long and 1e-200 high has area 0.5 and ratio 1e-400,
 /// which no f64 holds): each edge vector is scaled by its own largest component and the
@@ -791,6 +814,34 @@ mod tests {
             order.reverse();
         }
         assert!(seen.iter().all(|&e| e == first), "{first} vs {seen:?}");
+    }
+
+    #[test]
+    fn flat_input_quads_are_errors_and_straight_corners_are_not() {
+        // The square's two triangles and a quad (1, 4, 5, 2) beside them; node 5 moved.
+        let with_quad = |p5: [f64; 3], order: [u32; 4]| {
+            let mut data = square([0, 2, 3]);
+            data.vertices.extend([[2.0, 0.0, 0.0], p5]);
+            data.quads = vec![order];
+            data.quad_ids = vec![7];
+            data.quad_surface = vec![1];
+            Mesh::new(data)
+        };
+        assert!(with_quad([2.0, 1.0, 0.0], [1, 4, 5, 2]).is_ok());
+        // A straight corner at 4 (1, 4, 5 collinear) keeps an area: read, eta 0.
+        assert!(with_quad([3.0, 0.0, 0.0], [1, 4, 5, 2]).is_ok());
+        // Four collinear nodes, and a bow tie whose halves cancel.
+        for (p5, order) in [
+            ([3.0, 0.0, 0.0], [1, 4, 5, 0]),
+            ([2.0, 1.0, 0.0], [1, 5, 4, 2]),
+        ] {
+            let err = with_quad(p5, order).unwrap_err();
+            assert!(
+                matches!(err, MeshError::DegenerateQuad { element: 7, .. }),
+                "{err}"
+            );
+            assert!(err.to_string().starts_with("quad 7 is degenerate"), "{err}");
+        }
     }
 
     #[test]
