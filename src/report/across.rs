@@ -259,15 +259,27 @@ fn record(results: &Results, m: &Medians<'_>, j: usize, base: usize, seed: u64) 
     };
     for p in &family.pairs {
         let [mut a, mut b] = p.cmp.median;
+        // Who wins is the test's direction (A), not the medians': they can be equal on a
+        // significant difference.
+        let mut direction = p.cmp.direction();
         if swapped.contains(&p.first.as_str()) {
             (a, b) = (b, a);
+            direction = direction.reverse();
         }
-        let v = match (p.significant(), a.total_cmp(&b)) {
+        let v = match (p.significant(), direction) {
             (true, std::cmp::Ordering::Greater) => Verdict::Win,
             (true, std::cmp::Ordering::Less) => Verdict::Loss,
             _ => Verdict::Tie,
         };
-        let what = format!("{a:.2} vs {b:.2}, Holm p = {}", fmt_p(p.cmp.p_holm));
+        let av = if swapped.contains(&p.first.as_str()) {
+            1.0 - p.cmp.a
+        } else {
+            p.cmp.a
+        };
+        let what = format!(
+            "{a:.2} vs {b:.2}, A = {av:.2}, Holm p = {}",
+            fmt_p(p.cmp.p_holm)
+        );
         verdicts.push((index(&p.first), p.first.clone(), v, what));
     }
     for u in &family.untested {
@@ -410,8 +422,9 @@ pub(super) fn across_meshes(
             "Baseline: {}{}. On each mesh, a method's runs are tested against the baseline's \
              (Mann–Whitney U; the signed-rank test when one side is a single run), and the \
              p-values of one method's meshes are Holm-corrected together: a win is a \
-             significantly higher median quality at {ALPHA}, a loss a significantly lower one, \
-             a tie no significant difference. Between two single runs (deterministic methods) \
+             difference significant at {ALPHA} in the method's favour (Vargha–Delaney A above \
+             0.5: its runs tend to be higher, even where the medians are equal), a loss one \
+             against it, a tie no significant difference. Between two single runs (deterministic methods) \
              the exact difference decides.",
             m.label(base),
             if opts.baseline.is_some() {
@@ -653,7 +666,7 @@ fn answer(
     let head = format!("Does {b} ({why}) beat {bl} on every mesh?");
     let verdict = if r.wins.len() == meshes && meshes == n {
         format!(
-            " Yes: its median quality is significantly higher on all {n} meshes ({} runs of {b}, \
+            " Yes: its quality is significantly higher on all {n} meshes ({} runs of {b}, \
              {} of {bl}).",
             r.runs.0, r.runs.1
         )
@@ -676,8 +689,12 @@ fn answer(
                 if p.p_min > ALPHA {
                     format!(
                         " Over the meshes, the signed-rank test of their per-mesh medians cannot \
-                         decide: {} meshes differ, too few to reach p < {ALPHA}.",
-                        p.test.n
+                         decide: {} differ, too few to reach p < {ALPHA}.",
+                        if p.test.n == 1 {
+                            "1 mesh's medians".to_string()
+                        } else {
+                            format!("{} meshes' medians", p.test.n)
+                        }
                     )
                 } else {
                     format!(

@@ -260,7 +260,7 @@ impl Family {
                     p.first,
                     p.second,
                     Magnitude::of(p.cmp.a).name(),
-                    if p.cmp.median[0] >= p.cmp.median[1] {
+                    if p.cmp.direction().is_ge() {
                         "increase"
                     } else {
                         "decrease"

@@ -224,6 +224,42 @@ fn too_few_meshes_for_a_test_say_so() {
 }
 
 #[test]
+fn a_significant_difference_between_equal_medians_is_a_loss_or_a_decrease() {
+    // As on the committed budget-transfer grid: greedy's one run reaches 100, 32 of selective's
+    // 128 runs fall below it, none above; the medians are equal (100), the signed-rank test
+    // significant, A = 0.375. It was called a tie and a "small increase" (by the medians).
+    let tmp = tempfile::tempdir().unwrap();
+    let mut lines = Vec::new();
+    for (i, mesh) in ["a", "b"].iter().enumerate() {
+        lines.push(record(mesh, "greedy", None, 0, 100.0, 100.0, 0.02));
+        for run in 0..128 {
+            let q = if run % 4 == 0 {
+                99.0 - 0.01 * f64::from(run) - i as f64
+            } else {
+                100.0
+            };
+            lines.push(record(mesh, "selective", Some(5), run, q, 100.0, 0.05));
+        }
+    }
+    std::fs::write(tmp.path().join("runs.jsonl"), lines.join("\n") + "\n").unwrap();
+    let md = std::fs::read_to_string(report::write(tmp.path(), &opts()).unwrap().markdown).unwrap();
+    assert!(
+        md.contains("selective h=5 vs greedy (small decrease, A = 0.38)"),
+        "{md}"
+    );
+    assert!(!md.contains("increase"), "{md}");
+    let section = &md[md.find("## Across meshes").expect("no section")..];
+    let row = (section.lines())
+        .find(|l| l.starts_with("| selective h=5 |"))
+        .unwrap();
+    assert!(row.starts_with("| selective h=5 | 0 | 0 | 2 |"), "{row}");
+    assert!(
+        row.contains("a (loss: 100.00 vs 100.00, A = 0.38, Holm p = "),
+        "{row}"
+    );
+}
+
+#[test]
 fn unknown_baseline_is_a_usage_error() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("res");
