@@ -52,7 +52,7 @@ struct Cli {
 enum Command {
     /// Print a mesh's size, topology and candidate quad qualities.
     Info(info::Args),
-    /// Generate a procedural mesh (jittered grid, icosphere, strip, spiral, maze) of any size.
+    /// Generate a procedural mesh (jittered grid, icosphere, strip, spiral, maze, lattice) of any size.
     Generate(generate::Args),
     /// Recombine a mesh's triangles into quads with one policy.
     Recombine(recombine::Args),
@@ -115,6 +115,15 @@ impl RuleArgs {
     pub fn rule(&self) -> Result<quadrecomb::internals::quality::Rule, UsageError> {
         quadrecomb::internals::quality::Rule::new(self.min_eta, self.allow_invalid)
             .map_err(|e| UsageError(format!("--min-eta: {e}")))
+    }
+
+    /// The flags that give this rule again (for a child process).
+    pub fn flags(&self) -> Vec<String> {
+        if self.allow_invalid {
+            vec!["--allow-invalid".into()]
+        } else {
+            vec!["--min-eta".into(), format!("{:?}", self.min_eta)]
+        }
     }
 }
 

@@ -12,8 +12,9 @@ pub struct Args {
     /// Another results directory to compare with, configuration by configuration.
     #[arg(long, value_name = "DIR2")]
     compare: Option<PathBuf>,
-    /// Also draw the mesh pictures zoomed into this window (picture coordinates; negative
-    /// values need no `=`: `--zoom -1,-1,0,0`).
+    /// Also draw the mesh pictures zoomed into this window (mesh x-y for planar meshes,
+    /// view-plane coordinates for surfaces, as the pictures' axes show; negative values need
+    /// no `=`: `--zoom -1,-1,0,0`).
     #[arg(long, value_name = "x0,y0,x1,y1", allow_hyphen_values = true)]
     zoom: Option<String>,
     /// Picture the typical run of this configuration, e.g. `selective:5` or `greedy`

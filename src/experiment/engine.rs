@@ -474,11 +474,16 @@ fn check_resume(
         let s = |s: Option<super::manifest::Shard>| {
             s.map_or("the whole run list".to_string(), |s| format!("shard {s}"))
         };
-        return Err(mismatch(format!("{} vs {}", s(new.shard), s(old.shard))));
+        return Err(mismatch(format!(
+            "{} vs {} (this sweep's vs the directory's)",
+            s(new.shard),
+            s(old.shard)
+        )));
     }
     let Some(why) = new.incompatibility(old) else {
         return Ok(());
     };
+    let why = format!("{why} (this sweep's vs the directory's)");
     let refusal = new.extension_refusal(old);
     if extend {
         if new.shard.is_some() {
@@ -842,7 +847,7 @@ pub(crate) mod tests {
         // Back to fewer runs: refused, naming what would be dropped.
         let err = run(&m, &OK, &o, &no, &mut |_| {}).unwrap_err().to_string();
         assert!(
-            err.contains("would drop runs") && err.contains("a selective h=1: run 5"),
+            err.contains("would leave out runs") && err.contains("a selective h=1: run 5"),
             "{err}"
         );
         let mut seed = wider.clone();

@@ -389,8 +389,9 @@ impl Manifest {
             const SHOWN: usize = 6;
             let more = dropped.len().saturating_sub(SHOWN);
             format!(
-                "it would drop runs the directory holds: {}{} (an extension keeps every \
-                 configuration and run: give them again)",
+                "it would leave out runs the directory's configuration plans, recorded or \
+                 not yet run: {}{} (an extension keeps every configuration and run: give them \
+                 again)",
                 dropped[..dropped.len().min(SHOWN)].join("; "),
                 if more > 0 {
                     format!("; and {more} more configurations")
@@ -499,8 +500,9 @@ pub fn union_spec(a: &SweepSpec, b: &SweepSpec) -> SweepSpec {
     u
 }
 
-/// The first difference between two specs, in words.
+/// Every difference between two specs, in words (`a`'s vs `b`'s), joined by "; ".
 pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
+    let mut found: Vec<String> = Vec::new();
     if a.meshes != b.meshes {
         let names = |s: &SweepSpec| {
             s.meshes
@@ -509,16 +511,16 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
                 .collect::<Vec<_>>()
                 .join(", ")
         };
-        return Some(format!("meshes [{}] vs [{}]", names(a), names(b)));
+        found.push(format!("meshes [{}] vs [{}]", names(a), names(b)));
     }
     if a.algos != b.algos {
-        return Some(format!("algorithms {:?} vs {:?}", a.algos, b.algos));
+        found.push(format!("algorithms {:?} vs {:?}", a.algos, b.algos));
     }
     if a.horizons != b.horizons {
-        return Some(format!("horizons {:?} vs {:?}", a.horizons, b.horizons));
+        found.push(format!("horizons {:?} vs {:?}", a.horizons, b.horizons));
     }
     if a.budgets != b.budgets {
-        return Some(format!("budgets {:?} vs {:?}", a.budgets, b.budgets));
+        found.push(format!("budgets {:?} vs {:?}", a.budgets, b.budgets));
     }
     if a.time_budgets != b.time_budgets {
         let say = |v: &[super::calibrate::TimeBudget]| {
@@ -527,48 +529,48 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
                 .collect::<Vec<_>>()
                 .join(", ")
         };
-        return Some(format!(
+        found.push(format!(
             "time budgets [{}] vs [{}]",
             say(&a.time_budgets),
             say(&b.time_budgets)
         ));
     }
     if a.calibration != b.calibration {
-        return Some(
+        found.push(
             "the calibrations of the time budgets differ (another calibration: resume with the \
              directory's own manifest)"
                 .into(),
         );
     }
     if a.runs != b.runs {
-        return Some(format!("runs {} vs {}", a.runs, b.runs));
+        found.push(format!("runs {} vs {}", a.runs, b.runs));
     }
     if a.baseline_runs != b.baseline_runs {
-        return Some(format!(
+        found.push(format!(
             "baseline runs {} vs {}",
             a.baseline_runs, b.baseline_runs
         ));
     }
     if a.seed != b.seed {
-        return Some(format!("seed {} vs {}", a.seed, b.seed));
+        found.push(format!("seed {} vs {}", a.seed, b.seed));
     }
     if a.rule() != b.rule() {
-        return Some(format!("rule {} vs {}", a.rule(), b.rule()));
+        found.push(format!("rule {} vs {}", a.rule(), b.rule()));
     }
     if a.finish != b.finish {
         let say = |f: Option<super::finished::FinishSettings>| {
             f.map_or("no finish".to_string(), |s| s.to_string())
         };
-        return Some(format!("{} vs {}", say(a.finish), say(b.finish)));
+        found.push(format!("{} vs {}", say(a.finish), say(b.finish)));
     }
     if a.plan_version != b.plan_version {
-        return Some(format!(
+        found.push(format!(
             "plan version {} vs {} (seeds and run lists of different quadrecomb releases: \
              finish that sweep with the release that began it, or start a new one)",
             a.plan_version, b.plan_version
         ));
     }
-    None
+    (!found.is_empty()).then(|| found.join("; "))
 }
 
 #[cfg(test)]

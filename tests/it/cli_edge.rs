@@ -339,6 +339,46 @@ fn sizes_too_small_are_refused_with_the_limit() {
     );
 }
 
+/// `bench optimum` solves under the rule every other command uses and names it (it solved
+/// the paper-literal problem whatever the flags, a review's finding: borouchaki 13183.64
+/// against `optimum`'s 13170.04, without a word).
+#[test]
+fn bench_optimum_takes_and_names_the_rule() {
+    let tmp = tempfile::tempdir().unwrap();
+    let row = |extra: &[&str]| {
+        let mut args = vec![
+            "bench",
+            "optimum",
+            "--no-rss",
+            "--repeat",
+            "1",
+            "--sizes",
+            "100",
+            "--lattice-sizes",
+            "100",
+            "--meshes",
+            "borouchaki",
+        ];
+        args.extend_from_slice(extra);
+        let o = run_in(tmp.path(), &args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let out = String::from_utf8_lossy(&o.stdout).to_string();
+        let rule = out.lines().next().unwrap().to_string();
+        let line = out.lines().find(|l| l.starts_with("borouchaki")).unwrap();
+        let quality: f64 = line.split_whitespace().nth(4).unwrap().parse().unwrap();
+        (rule, quality)
+    };
+    let (rule, q) = row(&[]);
+    assert_eq!(rule, "Rule: valid quads (eta > 0).");
+    assert_eq!(format!("{q:.4}"), "13170.0382");
+    let (rule, q) = row(&["--allow-invalid"]);
+    assert!(rule.contains("paper-literal"), "{rule}");
+    assert_eq!(format!("{q:.4}"), "13183.6406");
+    let (rule, q) = row(&["--min-eta", "0.3"]);
+    assert_eq!(rule, "Rule: valid quads, eta >= 0.3.");
+    assert!(q < 13000.0, "{q}");
+}
+
 /// An output directory that takes no new file is refused before the search (it ran, then
 /// failed writing), for every command with `-o`.
 #[cfg(target_os = "linux")]

@@ -173,8 +173,8 @@ fn extend_refuses_what_would_change_or_drop_recorded_runs() {
         (
             "fewer runs",
             sweep_args(&mesh, "d", 3, "1..3"),
-            "would drop runs the directory holds: small selective h=1: runs 3..4; \
-             small selective h=2: runs 3..4",
+            "would leave out runs the directory's configuration plans, recorded or not yet \
+             run: small selective h=1: runs 3..4; small selective h=2: runs 3..4",
         ),
         (
             "a horizon",

@@ -4,7 +4,7 @@
 use crate::cli::UsageError;
 use quadrecomb::internals::mesh::Mesh;
 use quadrecomb::internals::mesh::generate::{self, GridSpec, MAX_GRID_TRIANGLES};
-use quadrecomb::internals::quality::CandidateTable;
+use quadrecomb::internals::quality::{CandidateTable, Rule};
 use quadrecomb::internals::search::optimum;
 use quadrecomb::internals::stats::describe::linear_fit;
 use std::process::{Command, ExitCode};
@@ -28,6 +28,8 @@ pub struct Args {
     /// Skip the peak-memory measurement (one child process per grid size).
     #[arg(long)]
     no_rss: bool,
+    #[command(flatten)]
+    rule: crate::cli::RuleArgs,
     /// Internal: solve one grid of this many triangles and print the peak RSS in bytes.
     #[arg(long, hide = true)]
     rss_child: Option<usize>,
@@ -55,14 +57,16 @@ fn check_sizes(flag: &str, sizes: &[usize]) -> Result<(), UsageError> {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     check_sizes("--sizes", &args.sizes)?;
     check_sizes("--lattice-sizes", &args.lattice_sizes)?;
+    let rule = args.rule.rule()?;
     if let Some(n) = args.rss_child {
         let mesh = grid(n, 1);
-        let table = CandidateTable::build(&mesh);
+        let table = CandidateTable::build(&mesh).restrict(&mesh, rule);
         let opt = optimum::solve(&mesh, &table);
         std::hint::black_box(&opt);
         outln!("{} {}", mesh.num_triangles(), peak_rss().unwrap_or(0));
         return Ok(ExitCode::SUCCESS);
     }
+    outln!("Rule: {rule}.");
     outln!(
         "{:<22} {:>10} {:>9} {:>6} {:>14} {:>10} {:>10} {:>12}",
         "mesh",
@@ -77,7 +81,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for spec in &args.meshes {
         match quadrecomb::internals::mesh::load(spec) {
             Ok(mesh) => {
-                let (opt, t, cpu) = time(&mesh, args.repeat);
+                let (opt, t, cpu) = time(&mesh, rule, args.repeat);
                 print_row(spec, &mesh, &opt, t, cpu, None);
             }
             Err(e) => outln!("{spec:<22} (not loadable here: {e})"),
@@ -91,8 +95,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         } else {
             args.repeat
         };
-        let (opt, t, cpu) = time(&mesh, repeat);
-        let rss = if args.no_rss { None } else { child_rss(n) };
+        let (opt, t, cpu) = time(&mesh, rule, repeat);
+        let rss = if args.no_rss {
+            None
+        } else {
+            child_rss(n, &args.rule)
+        };
         print_row(&format!("grid {n}"), &mesh, &opt, t, cpu, rss);
         points.push((mesh.num_triangles() as f64, cpu.unwrap_or(t)));
     }
@@ -110,7 +118,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         } else {
             args.repeat
         };
-        let (opt, t, cpu) = time(&mesh, repeat);
+        let (opt, t, cpu) = time(&mesh, rule, repeat);
         print_row(&format!("lattice {n}"), &mesh, &opt, t, cpu, None);
         points.push((mesh.num_triangles() as f64, cpu.unwrap_or(t)));
     }
@@ -146,12 +154,12 @@ fn print_row(
     );
 }
 
-/// Best wall time and mean on-CPU time of at least `repeat` solves, repeated until they add
+/// Best wall time and mean on-CPU time of at least `repeat` solves under `rule`, repeated until they add
 /// up to 0.3 s (table built once, outside the timing). On a shared machine the on-CPU time
 /// (the scheduler's count for this thread, coarse for one short run, hence the mean over many)
 /// is the steadier figure.
-fn time(mesh: &Mesh, repeat: usize) -> (optimum::Optimum, f64, Option<f64>) {
-    let table = CandidateTable::build(mesh);
+fn time(mesh: &Mesh, rule: Rule, repeat: usize) -> (optimum::Optimum, f64, Option<f64>) {
+    let table = CandidateTable::build(mesh).restrict(mesh, rule);
     let mut best: Option<optimum::Optimum> = None;
     let c0 = thread_cpu_s();
     let start = std::time::Instant::now();
@@ -180,10 +188,11 @@ fn thread_cpu_s() -> Option<f64> {
 }
 
 /// Peak RSS per triangle of a child process that builds and solves one grid.
-fn child_rss(n: usize) -> Option<f64> {
+fn child_rss(n: usize, rule: &crate::cli::RuleArgs) -> Option<f64> {
     let exe = std::env::current_exe().ok()?;
     let out = Command::new(exe)
         .args(["bench", "optimum", "--rss-child", &n.to_string()])
+        .args(rule.flags())
         .output()
         .ok()?;
     let text = String::from_utf8_lossy(&out.stdout);
