@@ -33,28 +33,34 @@ use internals::{experiment, gpu, mesh, output, quality, report, search, stats};
 
 // Meshes: reading, validating, writing.
 pub use mesh::msh::write as write_msh;
+pub use mesh::topology::{Edges, Topology};
 pub use mesh::vtu::write as write_vtu;
 pub use mesh::{Mesh, MeshData, MeshError, ReadError, Recombined, load};
 
 // Candidate pairs and their quality.
-pub use gpu::{Backend, Evaluator, GpuError};
+pub use gpu::{Backend, BackendNote, Evaluator, GpuError};
 pub use quality::{CandidateTable, ElementQuality, Rule, RuleError, quad_eta, recombined};
 
 // Methods.
 pub use search::optimum::{Optimum, solve as optimum};
-pub use search::{Algo, AlgoError, RunOutcome, Searcher, run};
+pub use search::state::State;
+pub use search::{Algo, AlgoError, Progress, RunOutcome, Searcher, run};
 
 // Finishing what a policy leaves (all quads, near the optimum).
-pub use internals::finish::{FinishConfig, Finished, finish};
+pub use internals::finish::all_quad::Split;
+pub use internals::finish::{FinishConfig, FinishError, Finished, StepFigures, finish};
 
 // Sweeps and their results.
 pub use experiment::ExperimentError;
+pub use experiment::calibrate::TimeBudget;
 pub use experiment::config::{ConfigError, SweepConfig, SweepRequest};
 pub use experiment::engine::EngineReport;
 pub use experiment::events::Event;
+pub use experiment::finished::FinishSettings;
 pub use experiment::manifest::Manifest;
 pub use experiment::record::RunRecord;
 pub use experiment::replay::{ReplayError, Replayed, Replayer};
+pub use experiment::store::Loaded;
 pub use experiment::store::read as read_records;
 pub use experiment::summary::Summary;
 pub use experiment::sweep::run as run_sweep;

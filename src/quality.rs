@@ -263,7 +263,49 @@ impl CandidateTable {
         table
     }
 
-    /// The full table with eta computed in f64 on the CPU (the reference).
+    /// Whether this table can be `mesh`'s: one entry per triangle, and a few candidates
+    /// (first, middle, last) whose quads are made of their pairs' vertices. O(1): it tells a
+    /// table of another mesh apart, not every corruption.
+    pub fn fits(&self, mesh: &Mesh) -> bool {
+        if self.by_triangle.len() != mesh.num_triangles()
+            || self.quads.len() != self.pairs.len()
+            || self.eta.len() != self.pairs.len()
+        {
+            return false;
+        }
+        let n = self.pairs.len();
+        let nt = mesh.num_triangles() as u32;
+        [0, n / 2, n.wrapping_sub(1)]
+            .into_iter()
+            .filter(|&c| c < n)
+            .all(|c| {
+                let [a, b] = self.pairs[c];
+                a < nt && b < nt && {
+                    let (ta, tb) = (mesh.triangles[a as usize], mesh.triangles[b as usize]);
+                    self.quads[c]
+                        .iter()
+                        .all(|v| ta.contains(v) || tb.contains(v))
+                }
+            })
+    }
+
+    /// Panics, naming both sizes, when [`Self::fits`] says this table is not `mesh`'s.
+    #[track_caller]
+    pub fn assert_fits(&self, mesh: &Mesh) {
+        assert!(
+            self.fits(mesh),
+            "the candidate table ({} triangles, {} candidates) was not built for this mesh ({} \
+             triangles): build it with CandidateTable::build(&mesh)",
+            self.by_triangle.len(),
+            self.pairs.len(),
+            mesh.num_triangles()
+        );
+    }
+
+    /// The full table with eta computed in f64 on the CPU (the reference): every pair of
+    /// neighbouring triangles, eta-0 quads included (the paper-literal problem,
+    /// `--allow-invalid`). The command line's default, the valid-quad rule, is
+    /// `CandidateTable::build(&mesh).restrict(&mesh, Rule::default())` ([`Self::restrict`]).
     pub fn build(mesh: &Mesh) -> CandidateTable {
         let mut table = CandidateTable::topology_only(mesh);
         table.eta = table
@@ -279,6 +321,7 @@ impl CandidateTable {
     /// ([`CandidateTable::dual_graph`]). Validity is decided on the f64 eta of each quad,
     /// computed here, so the result does not depend on what filled `eta`.
     pub fn restrict(self, mesh: &Mesh, rule: Rule) -> CandidateTable {
+        self.assert_fits(mesh);
         if rule == Rule::AllPairs {
             return self;
         }
@@ -432,14 +475,25 @@ impl ElementQuality {
 }
 
 /// The recombined mesh given by the chosen candidates (a matching: no triangle twice).
+///
+/// # Panics
+/// When `table` is not `mesh`'s ([`CandidateTable::assert_fits`]), a candidate is out of
+/// range, or two candidates share a triangle (they would make overlapping quads).
 pub fn recombined(mesh: &Mesh, table: &CandidateTable, chosen: &[u32]) -> Recombined {
+    table.assert_fits(mesh);
     let mut used = vec![false; mesh.num_triangles()];
     let mut out = Recombined::default();
     for &c in chosen {
+        assert!(
+            (c as usize) < table.len(),
+            "candidate {c} does not exist (the table has {})",
+            table.len()
+        );
         let [a, b] = table.pairs[c as usize];
-        debug_assert!(
+        assert!(
             !used[a as usize] && !used[b as usize],
-            "candidate {c} reuses a triangle"
+            "candidate {c} reuses triangle {} of an earlier chosen candidate: not a matching",
+            if used[a as usize] { a } else { b }
         );
         used[a as usize] = true;
         used[b as usize] = true;

@@ -160,12 +160,17 @@ fn figures(table: &CandidateTable, pairing: &Pairing, time_s: f64) -> StepFigure
 /// with all-quad: when sheet refinement cannot refine a component no boundary split fixes
 /// ([`FinishError::Sheet`]: a sheet meets an input quad, a degenerate triangle), or (a bug)
 /// when a split goes wrong.
+///
+/// # Panics
+/// When `table` was not built for `mesh` ([`CandidateTable::assert_fits`]), or `chosen` is
+/// not a matching of its candidates.
 pub fn finish(
     mesh: &Mesh,
     table: &CandidateTable,
     chosen: &[u32],
     config: FinishConfig,
 ) -> Result<Finished, FinishError> {
+    table.assert_fits(mesh);
     let nt = mesh.num_triangles();
     let mut stats = FinishStats::default();
     let t0 = Instant::now();

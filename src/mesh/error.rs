@@ -45,6 +45,17 @@ pub enum MeshError {
     )]
     DegenerateQuad { element: u64, nodes: [u64; 4] },
     #[error(
+        "the mesh data's {field} holds {len} entries for {expected} {of} (one each, or none for the default)"
+    )]
+    Inconsistent {
+        field: &'static str,
+        len: usize,
+        expected: usize,
+        of: &'static str,
+    },
+    #[error("node tag {tag} is given to two vertices (tags must be unique)")]
+    DuplicateNodeTag { tag: u64 },
+    #[error(
         "element tag {tag} is given to two elements (tags must be unique: Gmsh would keep only the last one)"
     )]
     DuplicateElementTag { tag: u64 },

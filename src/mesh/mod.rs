@@ -81,12 +81,31 @@ impl MeshData {
     pub fn check_elements(&mut self) -> Result<(), MeshError> {
         self.materialise_defaults();
         let nv = self.vertices.len();
-        assert_eq!(self.vertex_ids.len(), nv, "one id per vertex");
-        assert_eq!(
-            self.triangle_ids.len(),
-            self.triangles.len(),
-            "one id per triangle"
-        );
+        let (nt, nq) = (self.triangles.len(), self.quads.len());
+        for (field, len, expected, of) in [
+            ("vertex_ids", self.vertex_ids.len(), nv, "vertices"),
+            ("triangle_ids", self.triangle_ids.len(), nt, "triangles"),
+            (
+                "triangle_surface",
+                self.triangle_surface.len(),
+                nt,
+                "triangles",
+            ),
+            ("quad_ids", self.quad_ids.len(), nq, "quads"),
+            ("quad_surface", self.quad_surface.len(), nq, "quads"),
+        ] {
+            if len != expected {
+                return Err(MeshError::Inconsistent {
+                    field,
+                    len,
+                    expected,
+                    of,
+                });
+            }
+        }
+        if let Some(tag) = repeated(self.vertex_ids.iter().copied()) {
+            return Err(MeshError::DuplicateNodeTag { tag });
+        }
         for (i, p) in self.vertices.iter().enumerate() {
             if !p.iter().all(|c| c.is_finite()) {
                 return Err(MeshError::NonFiniteCoordinate {

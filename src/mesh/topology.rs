@@ -845,6 +845,49 @@ mod tests {
     }
 
     #[test]
+    fn mesh_data_of_inconsistent_lengths_or_repeated_node_tags_is_an_error() {
+        // They panicked (an assert in check_elements), or a short quad_surface lost quads
+        // in the written file, or repeated node tags made a file `load` refuses (a library
+        // user's review).
+        let mut data = square([0, 2, 3]);
+        data.vertex_ids = vec![1, 2];
+        let err = Mesh::new(data).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "the mesh data's vertex_ids holds 2 entries for 4 vertices (one each, or none for \
+             the default)"
+        );
+        let mut data = square([0, 2, 3]);
+        data.vertices.extend([[2.0, 0.0, 0.0], [2.0, 1.0, 0.0]]);
+        data.quads = vec![[1, 4, 5, 2], [1, 4, 5, 2]];
+        data.quad_surface = vec![1];
+        assert!(matches!(
+            Mesh::new(data).unwrap_err(),
+            MeshError::Inconsistent {
+                field: "quad_surface",
+                len: 1,
+                expected: 2,
+                ..
+            }
+        ));
+        let mut data = square([0, 2, 3]);
+        data.triangle_surface = vec![1, 1, 1];
+        assert!(matches!(
+            Mesh::new(data).unwrap_err(),
+            MeshError::Inconsistent {
+                field: "triangle_surface",
+                ..
+            }
+        ));
+        let mut data = square([0, 2, 3]);
+        data.vertex_ids = vec![5, 9, 5, 7];
+        assert_eq!(
+            Mesh::new(data).unwrap_err(),
+            MeshError::DuplicateNodeTag { tag: 5 }
+        );
+    }
+
+    #[test]
     fn empty_and_triangle_free_meshes_are_errors() {
         assert_eq!(
             Mesh::new(MeshData::default()).unwrap_err(),

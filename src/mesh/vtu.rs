@@ -35,16 +35,14 @@ pub enum Encoding {
     Ascii,
 }
 
-/// Writes `mesh` recombined as `rec` to `path` as a binary `.vtu` file.
+/// Writes `mesh` recombined as `rec` to `path` as a binary `.vtu` file, whole or not at all
+/// ([`crate::output::write_atomic`]): on an error an existing file stays as it was.
 pub fn write(path: &Path, mesh: &Mesh, rec: &Recombined) -> Result<(), ReadError> {
-    let io = |source| ReadError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = std::fs::File::create(path).map_err(io)?;
-    let mut w = io::BufWriter::new(file);
-    write_to(&mut w, mesh, rec, Encoding::Binary).map_err(io)?;
-    w.flush().map_err(io)
+    crate::output::write_atomic(path, |mut w| write_to(&mut w, mesh, rec, Encoding::Binary))
+        .map_err(|source| ReadError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
 }
 
 /// One data array of the file.

@@ -4,9 +4,11 @@
 //!
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! use quadrecomb::{Algo, CandidateTable, Searcher};
+//! use quadrecomb::{Algo, CandidateTable, Rule, Searcher};
 //! let mesh = quadrecomb::load("sphere")?;
-//! let table = CandidateTable::build(&mesh);
+//! // The valid-quad rule, as the command line applies it (without `restrict`: every pair,
+//! // eta-0 quads included, as `--allow-invalid`).
+//! let table = CandidateTable::build(&mesh).restrict(&mesh, Rule::default());
 //! let mut searcher = Searcher::new(&mesh, &table);
 //! for seed in 0..4 {
 //!     let out = searcher.run(Algo::selective(3), seed);
@@ -216,7 +218,11 @@ impl<'a> Searcher<'a> {
 
     /// A searcher for `mesh` and `table` (the state and the eta order are built when a run
     /// first needs them).
+    ///
+    /// # Panics
+    /// When `table` was not built for `mesh` ([`CandidateTable::assert_fits`]).
     pub fn new(mesh: &'a Mesh, table: &'a CandidateTable) -> Searcher<'a> {
+        table.assert_fits(mesh);
         Searcher {
             state: LazyState {
                 mesh,

@@ -1776,3 +1776,41 @@ fn second_order_meshes_say_what_was_skipped() {
         "{text}"
     );
 }
+
+/// The library's writers keep an existing file when they fail (a quad naming a vertex past
+/// the end): they truncated it to 0 bytes first (a library user's review; the CLI wrote
+/// through a temporary of its own).
+#[test]
+fn a_failed_library_write_leaves_the_existing_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mesh = mesh::load("sphere").unwrap();
+    let good = Recombined::unrecombined(&mesh);
+    let bad = Recombined {
+        quads: vec![[0, 1, 2, u32::MAX - 1]],
+        quad_surface: vec![mesh.triangle_surface[0]],
+        quad_eta: vec![0.5],
+        leftover: Vec::new(),
+    };
+    for name in ["keep.msh", "keep.vtu"] {
+        let path = tmp.path().join(name);
+        let write = |rec: &Recombined| {
+            if name.ends_with(".msh") {
+                msh::write(&path, &mesh, rec)
+            } else {
+                vtu::write(&path, &mesh, rec)
+            }
+        };
+        write(&good).unwrap();
+        let before = std::fs::read(&path).unwrap();
+        assert!(!before.is_empty());
+        let err = write(&bad).expect_err("a quad past the vertices is an error");
+        assert!(err.to_string().contains(name), "{err}");
+        assert_eq!(std::fs::read(&path).unwrap(), before, "{name} changed");
+        let left: Vec<_> = std::fs::read_dir(tmp.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .filter(|n| n.to_string_lossy().ends_with(".tmp"))
+            .collect();
+        assert!(left.is_empty(), "temporaries left: {left:?}");
+    }
+}

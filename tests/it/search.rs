@@ -658,3 +658,52 @@ fn bench_memory_prints_one_row_per_size() {
         assert_eq!(out.status.code(), Some(2), "{bad:?}");
     }
 }
+
+/// A table of another mesh is refused with a message naming both (a library user's review:
+/// index out of bounds in the searches, "bad edge 458-2290" in the optimum, and, the other
+/// way round, the sphere's optimum returned for borouchaki without a word); `recombined`
+/// refuses candidates that share a triangle (it wrote overlapping quads).
+#[test]
+fn a_table_of_another_mesh_and_overlapping_quads_are_refused() {
+    let boro = quadrecomb::load("borouchaki").unwrap();
+    let sphere = quadrecomb::load("sphere").unwrap();
+    let (tb, ts) = (CandidateTable::build(&boro), CandidateTable::build(&sphere));
+    assert!(tb.fits(&boro) && ts.fits(&sphere));
+    assert!(!tb.fits(&sphere) && !ts.fits(&boro));
+    let message = |f: &dyn Fn()| {
+        let err = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_err();
+        err.downcast_ref::<String>().cloned().unwrap_or_default()
+    };
+    type Call<'a> = (&'static str, Box<dyn Fn() + 'a>);
+    let calls: [Call<'_>; 6] = [
+        (
+            "run",
+            Box::new(|| drop(search::run(&boro, &ts, Algo::greedy(), 0))),
+        ),
+        ("searcher", Box::new(|| drop(Searcher::new(&sphere, &tb)))),
+        (
+            "optimum",
+            Box::new(|| drop(quadrecomb::optimum(&boro, &ts))),
+        ),
+        (
+            "optimum'",
+            Box::new(|| drop(quadrecomb::optimum(&sphere, &tb))),
+        ),
+        (
+            "recombined",
+            Box::new(|| drop(quadrecomb::recombined(&boro, &ts, &[]))),
+        ),
+        (
+            "restrict",
+            Box::new(|| drop(ts.clone().restrict(&boro, Rule::default()))),
+        ),
+    ];
+    for (what, f) in calls {
+        let m = message(&*f);
+        assert!(m.contains("was not built for this mesh"), "{what}: {m}");
+    }
+    let m = message(&|| drop(quadrecomb::recombined(&sphere, &ts, &[0, 0])));
+    assert!(m.contains("not a matching"), "{m}");
+    let m = message(&|| drop(quadrecomb::recombined(&sphere, &ts, &[u32::MAX - 1])));
+    assert!(m.contains("does not exist"), "{m}");
+}

@@ -165,14 +165,14 @@ pub fn read_bytes(name: &str, bytes: &[u8]) -> Result<Mesh, ReadError> {
 /// [`Model`]: `$PhysicalNames`, its entities, every node on the entity it was classified on
 /// (with its parametric coordinates), its point and line elements first; a mesh without one
 /// (generated) has one surface entity per surface tag, each node on the first surface that
-/// uses it. Node tags are the mesh's; elements are numbered from 1.
+/// uses it. Node tags are the mesh's; elements are numbered from 1. The file is written whole
+/// or not at all ([`crate::output::write_atomic`]): on an error an existing file stays as it
+/// was.
 pub fn write(path: &Path, mesh: &Mesh, rec: &Recombined) -> Result<(), ReadError> {
-    let io = |source| ReadError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = std::fs::File::create(path).map_err(io)?;
-    let mut w = std::io::BufWriter::new(file);
-    write_to(&mut w, mesh, rec).map_err(io)?;
-    std::io::Write::flush(&mut w).map_err(io)
+    crate::output::write_atomic(path, |mut w| write_to(&mut w, mesh, rec)).map_err(|source| {
+        ReadError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
 }

@@ -50,7 +50,11 @@ pub fn graph(mesh: &Mesh, table: &CandidateTable) -> blossom::Graph {
 }
 
 /// Maximum-weight matching of maximum cardinality of the dual graph, weights eta.
+///
+/// # Panics
+/// When `table` was not built for `mesh` ([`CandidateTable::assert_fits`]).
 pub fn solve(mesh: &Mesh, table: &CandidateTable) -> Optimum {
+    table.assert_fits(mesh);
     solve_certified(mesh, table, false).0
 }
 
