@@ -140,6 +140,15 @@ impl MeshData {
                 }
             }
         }
+        // Input quads of zero area, here so that a file of quads only (`info`) is checked too.
+        for (q, quad) in self.quads.iter().enumerate() {
+            if topology::quad_is_flat(quad.map(|v| self.vertices[v as usize])) {
+                return Err(MeshError::DegenerateQuad {
+                    element: self.quad_ids[q],
+                    nodes: quad.map(|v| self.vertex_ids[v as usize]),
+                });
+            }
+        }
         if let Some(tag) = repeated(self.triangle_ids.iter().chain(&self.quad_ids).copied()) {
             return Err(MeshError::DuplicateElementTag { tag });
         }

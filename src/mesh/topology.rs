@@ -278,14 +278,6 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             });
         }
     }
-    for (q, quad) in data.quads.iter().enumerate() {
-        if quad_is_flat(quad.map(|v| data.vertices[v as usize])) {
-            return Err(MeshError::DegenerateQuad {
-                element: data.quad_ids[q],
-                nodes: quad.map(|v| data.vertex_ids[v as usize]),
-            });
-        }
-    }
     let half = HalfEdges::new(nv, &data.triangles, &data.quads)?;
     if let Some((first, second)) = half.duplicate_triangle(&data.triangles) {
         return Err(MeshError::DuplicateTriangle {
@@ -548,7 +540,7 @@ pub(crate) fn norm(a: [f64; 3]) -> f64 {
 /// within rounding, relative to its longest diagonal, as a triangle's is tested: four
 /// collinear nodes, or a bow tie whose halves cancel. A quad with a straight or reflex
 /// corner has an area and is read (its eta is 0, which `info` counts as poor).
-fn quad_is_flat([a, b, c, d]: [[f64; 3]; 4]) -> bool {
+pub(super) fn quad_is_flat([a, b, c, d]: [[f64; 3]; 4]) -> bool {
     let (mut u, mut w) = (sub(c, a), sub(d, b));
     let m = u.iter().chain(&w).fold(0.0f64, |m, x| m.max(x.abs()));
     if m > 0.0 && m.is_finite() {

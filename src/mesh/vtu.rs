@@ -36,7 +36,10 @@ pub enum Encoding {
 }
 
 /// Writes `mesh` recombined as `rec` to `path` as a binary `.vtu` file, whole or not at all
-/// ([`crate::output::write_atomic`]): on an error an existing file stays as it was.
+/// ([`crate::output::write_atomic`]): through a temporary file in `path`'s directory (which
+/// must be writable), renamed over it, so on an error an existing file stays as it was; a
+/// `path` that exists and is not a regular file (a directory, FIFO or device such as
+/// `/dev/stdout`) is refused. To write a stream, use [`write_to`].
 pub fn write(path: &Path, mesh: &Mesh, rec: &Recombined) -> Result<(), ReadError> {
     crate::output::write_atomic(path, |mut w| write_to(&mut w, mesh, rec, Encoding::Binary))
         .map_err(|source| ReadError::Io {

@@ -404,12 +404,23 @@ pub struct Comparison {
 }
 
 impl Comparison {
-    /// Which sample tends to be larger, as the rank tests ask: by Vargha–Delaney A (above
-    /// 0.5, the first), by the medians only when A is exactly 0.5. The medians alone can
-    /// mislead: 95 of 128 runs equal to a single baseline value and 33 below it have the
-    /// baseline's median, yet are significantly lower (A = 0.37).
+    /// Which sample tends to be larger, in the sense of the test that was run: for
+    /// Mann–Whitney, Vargha–Delaney A (U / n1 n2) against 0.5; for the signed-rank test
+    /// against a single value, T+ against its expectation n (n + 1) / 4 (ranks weigh the
+    /// differences' sizes, so A, a count of runs above and below, can point the other way:
+    /// 60 runs slightly above and 40 far below give A = 0.60 and a significantly low T+). The
+    /// medians decide only a tie of these. The medians alone mislead: 95 of 128 runs equal
+    /// to a single baseline value and 33 below it have the baseline's median, yet are
+    /// significantly lower.
     pub fn direction(&self) -> std::cmp::Ordering {
-        match self.a.partial_cmp(&0.5) {
+        let by_test = match self.test {
+            Test::MannWhitney(_) => self.a.partial_cmp(&0.5),
+            Test::SignedRank(t) => {
+                let n = t.n as f64;
+                t.t_plus.partial_cmp(&(n * (n + 1.0) / 4.0))
+            }
+        };
+        match by_test {
             Some(std::cmp::Ordering::Equal) | None => self.median[0].total_cmp(&self.median[1]),
             Some(o) => o,
         }
@@ -458,6 +469,26 @@ pub fn adjust_family(family: &mut [Comparison]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn direction_is_the_tests_own() {
+        use std::cmp::Ordering::{Greater, Less};
+        // Against one value: 60 runs slightly above, 40 far below. A counts runs (0.60), the
+        // signed-rank test weighs sizes: significantly lower.
+        let mut x: Vec<f64> = (1..=60).map(|i| 100.0 + 0.001 * f64::from(i)).collect();
+        x.extend((1..=40).map(|i| 100.0 - 1.0 - 0.1 * f64::from(i)));
+        let c = compare(&x, &[100.0], 1);
+        assert!((c.a - 0.6).abs() < 1e-12 && c.test.p() < 0.05, "{c:?}");
+        assert_eq!(c.direction(), Less);
+        // Equal medians, significantly lower (the committed budget-transfer grid's shape).
+        let mut y = vec![100.0; 95];
+        y.extend((0..33).map(|i| 99.0 - f64::from(i)));
+        let c = compare(&y, &[100.0; 1], 1);
+        assert_eq!((c.median[0], c.direction()), (100.0, Less));
+        // Two samples: Mann–Whitney's direction is A's.
+        let c = compare(&[2.0, 3.0, 4.0], &[1.0, 2.5, 3.5], 1);
+        assert_eq!(c.direction(), Greater);
+    }
 
     #[test]
     fn ranks_average_ties() {

@@ -1814,3 +1814,18 @@ fn a_failed_library_write_leaves_the_existing_file() {
         assert!(left.is_empty(), "temporaries left: {left:?}");
     }
 }
+
+/// `info` on a file of quads only checks them as `Mesh::new` does: a quad of four collinear
+/// nodes is refused naming it (it was read and counted as a quad of eta 0; a second reading
+/// of the check, which first ran only where triangles were recombined).
+#[test]
+fn info_refuses_a_flat_quad_in_a_file_of_quads_only() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 2 0 0\n\
+                4 3 0 0\n$EndNodes\n$Elements\n1\n7 3 2 1 1 1 2 3 4\n$EndElements\n";
+    std::fs::write(tmp.path().join("flat.msh"), file).unwrap();
+    let o = run_in(tmp.path(), &["info", "flat.msh"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(err.contains("flat.msh: quad 7 is degenerate"), "{err}");
+}

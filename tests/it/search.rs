@@ -675,12 +675,13 @@ fn a_table_of_another_mesh_and_overlapping_quads_are_refused() {
         err.downcast_ref::<String>().cloned().unwrap_or_default()
     };
     type Call<'a> = (&'static str, Box<dyn Fn() + 'a>);
-    let calls: [Call<'_>; 6] = [
+    let calls: [Call<'_>; 7] = [
         (
             "run",
             Box::new(|| drop(search::run(&boro, &ts, Algo::greedy(), 0))),
         ),
         ("searcher", Box::new(|| drop(Searcher::new(&sphere, &tb)))),
+        ("state", Box::new(|| drop(State::new(&sphere, &tb)))),
         (
             "optimum",
             Box::new(|| drop(quadrecomb::optimum(&boro, &ts))),

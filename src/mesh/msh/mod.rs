@@ -166,8 +166,10 @@ pub fn read_bytes(name: &str, bytes: &[u8]) -> Result<Mesh, ReadError> {
 /// (with its parametric coordinates), its point and line elements first; a mesh without one
 /// (generated) has one surface entity per surface tag, each node on the first surface that
 /// uses it. Node tags are the mesh's; elements are numbered from 1. The file is written whole
-/// or not at all ([`crate::output::write_atomic`]): on an error an existing file stays as it
-/// was.
+/// or not at all ([`crate::output::write_atomic`]): through a temporary file in `path`'s
+/// directory (which must be writable), renamed over it, so on an error an existing file stays
+/// as it was; a `path` that exists and is not a regular file (a directory, FIFO or device such
+/// as `/dev/stdout`) is refused. To write a stream, use [`write_to`].
 pub fn write(path: &Path, mesh: &Mesh, rec: &Recombined) -> Result<(), ReadError> {
     crate::output::write_atomic(path, |mut w| write_to(&mut w, mesh, rec)).map_err(|source| {
         ReadError::Io {

@@ -10,7 +10,11 @@ use crate::quality::CandidateTable;
 
 impl<'a> State<'a> {
     /// The initial state of `mesh` (every triangle remaining) with every verdict computed.
+    ///
+    /// # Panics
+    /// When `table` was not built for `mesh` ([`CandidateTable::assert_fits`]).
     pub fn new(mesh: &'a Mesh, table: &'a CandidateTable) -> State<'a> {
+        table.assert_fits(mesh);
         let nt = mesh.num_triangles();
         let nv = mesh.vertices.len();
         let m = table.len();
