@@ -41,7 +41,7 @@ pub enum MeshError {
         log10_height: f64,
     },
     #[error(
-        "quad {element} is degenerate (its area is zero to within rounding: four collinear nodes, or two halves folded onto each other): nodes {nodes:?}"
+        "quad {element} is degenerate (its four nodes are collinear to within rounding: zero area): nodes {nodes:?}"
     )]
     DegenerateQuad { element: u64, nodes: [u64; 4] },
     #[error(

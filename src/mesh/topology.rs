@@ -536,19 +536,26 @@ pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// An input quad whose vector area (half the cross product of its diagonals) is zero to
-/// within rounding, relative to its longest diagonal, as a triangle's is tested: four
-/// collinear nodes, or a bow tie whose halves cancel. A quad with a straight or reflex
-/// corner has an area and is read (its eta is 0, which `info` counts as poor).
-pub(super) fn quad_is_flat([a, b, c, d]: [[f64; 3]; 4]) -> bool {
-    let (mut u, mut w) = (sub(c, a), sub(d, b));
-    let m = u.iter().chain(&w).fold(0.0f64, |m, x| m.max(x.abs()));
-    if m > 0.0 && m.is_finite() {
-        u = u.map(|x| x / m);
-        w = w.map(|x| x / m);
+/// An input quad whose four nodes are collinear to within rounding: each of the four
+/// triangles of three of its corners is flat as a triangle is tested (area against the
+/// longest side, 1e-14). A quad with a straight or reflex corner, or a self-intersecting one
+/// (a bow tie), keeps an area in some corner triangle and is read (its eta is 0, which `info`
+/// counts as poor).
+pub(super) fn quad_is_flat(p: [[f64; 3]; 4]) -> bool {
+    // Scale-free: the largest coordinate difference brought to 1.
+    let m = (1..4)
+        .flat_map(|i| sub(p[i], p[0]))
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    if !(m > 0.0 && m.is_finite()) {
+        return m == 0.0;
     }
-    let scale = dot(u, u).max(dot(w, w));
-    norm(cross(u, w)) <= 1e-14 * scale || scale == 0.0
+    let q = p.map(|x| sub(x, p[0]).map(|c| c / m));
+    (0..4).all(|i| {
+        let (a, b, c) = (q[i], q[(i + 1) % 4], q[(i + 2) % 4]);
+        let (u, w) = (sub(b, a), sub(c, a));
+        let scale = dot(u, u).max(dot(w, w)).max(dot(sub(w, u), sub(w, u)));
+        norm(cross(u, w)) <= 1e-14 * scale || scale == 0.0
+    })
 }
 
 /// log10 of the smallest height of triangle `abc` over its longest edge, without
@@ -822,10 +829,12 @@ mod tests {
         assert!(with_quad([2.0, 1.0, 0.0], [1, 4, 5, 2]).is_ok());
         // A straight corner at 4 (1, 4, 5 collinear) keeps an area: read, eta 0.
         assert!(with_quad([3.0, 0.0, 0.0], [1, 4, 5, 2]).is_ok());
-        // Four collinear nodes, and a bow tie whose halves cancel.
+        // A bow tie (self-intersecting, halves cancelling) is read too: eta 0.
+        assert!(with_quad([2.0, 1.0, 0.0], [1, 5, 4, 2]).is_ok());
+        // Four collinear nodes, also with two of them coincident.
         for (p5, order) in [
             ([3.0, 0.0, 0.0], [1, 4, 5, 0]),
-            ([2.0, 1.0, 0.0], [1, 5, 4, 2]),
+            ([2.0, 0.0, 0.0], [1, 4, 5, 0]),
         ] {
             let err = with_quad(p5, order).unwrap_err();
             assert!(
