@@ -260,17 +260,7 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
     assert_eq!(data.triangle_surface.len(), nt, "one surface per triangle");
     for (t, tri) in data.triangles.iter().enumerate() {
         let [a, b, c] = tri.map(|v| data.vertices[v as usize]);
-        let (mut u, mut w) = (sub(b, a), sub(c, a));
-        // The test is scale-free: bring the largest component to 1 so that the squares below
-        // neither overflow nor underflow for very large or very small coordinates.
-        let m = u.iter().chain(&w).fold(0.0f64, |m, x| m.max(x.abs()));
-        if m > 0.0 && m.is_finite() {
-            u = u.map(|x| x / m);
-            w = w.map(|x| x / m);
-        }
-        let area2 = norm(cross(u, w));
-        let scale = dot(u, u).max(dot(w, w)).max(dot(sub(w, u), sub(w, u)));
-        if area2 <= 1e-14 * scale || scale == 0.0 {
+        if triangle_is_flat(a, b, c) {
             return Err(MeshError::DegenerateTriangle {
                 element: data.triangle_ids[t],
                 nodes: tri.map(|v| data.vertex_ids[v as usize]),
@@ -536,26 +526,26 @@ pub(crate) fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// An input quad whose four nodes are collinear to within rounding: each of the four
-/// triangles of three of its corners is flat as a triangle is tested (area against the
-/// longest side, 1e-14). A quad with a straight or reflex corner, or a self-intersecting one
-/// (a bow tie), keeps an area in some corner triangle and is read (its eta is 0, which `info`
-/// counts as poor).
-pub(super) fn quad_is_flat(p: [[f64; 3]; 4]) -> bool {
-    // Scale-free: the largest coordinate difference brought to 1.
-    let m = (1..4)
-        .flat_map(|i| sub(p[i], p[0]))
-        .fold(0.0f64, |m, x| m.max(x.abs()));
-    if !(m > 0.0 && m.is_finite()) {
-        return m == 0.0;
+/// Triangle `abc` has no area to within rounding: twice its area at most 1e-14 times its
+/// longest side squared. Scale-free: the largest component of the edge vectors is brought to
+/// 1, so that the squares neither overflow nor underflow for very large or small coordinates.
+fn triangle_is_flat(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> bool {
+    let (mut u, mut w) = (sub(b, a), sub(c, a));
+    let m = u.iter().chain(&w).fold(0.0f64, |m, x| m.max(x.abs()));
+    if m > 0.0 && m.is_finite() {
+        u = u.map(|x| x / m);
+        w = w.map(|x| x / m);
     }
-    let q = p.map(|x| sub(x, p[0]).map(|c| c / m));
-    (0..4).all(|i| {
-        let (a, b, c) = (q[i], q[(i + 1) % 4], q[(i + 2) % 4]);
-        let (u, w) = (sub(b, a), sub(c, a));
-        let scale = dot(u, u).max(dot(w, w)).max(dot(sub(w, u), sub(w, u)));
-        norm(cross(u, w)) <= 1e-14 * scale || scale == 0.0
-    })
+    let scale = dot(u, u).max(dot(w, w)).max(dot(sub(w, u), sub(w, u)));
+    norm(cross(u, w)) <= 1e-14 * scale || scale == 0.0
+}
+
+/// An input quad whose four nodes are collinear to within rounding: each of the four
+/// triangles of three of its corners is flat ([`triangle_is_flat`]). A quad with a straight
+/// or reflex corner, or a self-intersecting one (a bow tie), keeps an area in some corner
+/// triangle and is read (its eta is 0, which `info` counts as poor).
+pub(super) fn quad_is_flat(p: [[f64; 3]; 4]) -> bool {
+    (0..4).all(|i| triangle_is_flat(p[i], p[(i + 1) % 4], p[(i + 2) % 4]))
 }
 
 /// log10 of the smallest height of triangle `abc` over its longest edge, without

@@ -259,22 +259,17 @@ fn record(results: &Results, m: &Medians<'_>, j: usize, base: usize, seed: u64) 
     };
     for p in &family.pairs {
         let [mut a, mut b] = p.cmp.median;
-        // Who wins is the test's direction (A), not the medians': they can be equal on a
+        // Who wins is the test's direction, not the medians': they can be equal on a
         // significant difference.
-        let mut direction = p.cmp.direction();
+        let (mut direction, mut av) = (p.cmp.direction(), p.cmp.a);
         if swapped.contains(&p.first.as_str()) {
             (a, b) = (b, a);
-            direction = direction.reverse();
+            (direction, av) = (direction.reverse(), 1.0 - av);
         }
         let v = match (p.significant(), direction) {
             (true, std::cmp::Ordering::Greater) => Verdict::Win,
             (true, std::cmp::Ordering::Less) => Verdict::Loss,
             _ => Verdict::Tie,
-        };
-        let av = if swapped.contains(&p.first.as_str()) {
-            1.0 - p.cmp.a
-        } else {
-            p.cmp.a
         };
         let what = format!(
             "{a:.2} vs {b:.2}, A = {av:.2}, Holm p = {}",
@@ -422,9 +417,9 @@ pub(super) fn across_meshes(
             "Baseline: {}{}. On each mesh, a method's runs are tested against the baseline's \
              (Mann–Whitney U; the signed-rank test when one side is a single run), and the \
              p-values of one method's meshes are Holm-corrected together: a win is a \
-             difference significant at {ALPHA} in the method's favour (Vargha–Delaney A above \
-             0.5: its runs tend to be higher, even where the medians are equal), a loss one \
-             against it, a tie no significant difference. Between two single runs (deterministic methods) \
+             difference significant at {ALPHA} in the method's favour (in the test's direction: \
+             Vargha–Delaney A above 0.5 for Mann–Whitney, T+ above its expectation for the \
+             signed-rank test; the medians may be equal), a loss one against it, a tie no significant difference. Between two single runs (deterministic methods) \
              the exact difference decides.",
             m.label(base),
             if opts.baseline.is_some() {
