@@ -247,7 +247,15 @@ fn normalisation(vertices: &[[f64; 3]]) -> ([f64; 3], f64) {
     let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
     let half = (0..3).map(|k| 0.5 * (hi[k] - lo[k])).fold(0.0, f64::max);
     let inv = if half > 0.0 && half.is_finite() {
-        1.0 / half
+        // Below about 5.6e-309 (subnormal), 1 / half overflows: the largest power of two
+        // still brings every coordinate into f32's normal range (eta does not depend on
+        // the scale). An infinite scale made every eta 0 on a mesh of extent 1e-310.
+        let inv = 1.0 / half;
+        if inv.is_finite() {
+            inv
+        } else {
+            2f64.powi(1023)
+        }
     } else {
         1.0
     };
@@ -257,6 +265,32 @@ fn normalisation(vertices: &[[f64; 3]]) -> ([f64; 3], f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_subnormal_extent_scales_to_finite_coordinates() {
+        // A unit square scaled by 1e-310: 1 / half overflowed to inf, the coordinates to
+        // inf / NaN, and every eta read 0 on the device and the CPU twin.
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [1e-310, 0.0, 0.0],
+            [1e-310, 1e-310, 0.0],
+            [0.0, 1e-310, 0.0],
+        ];
+        let (centre, inv) = normalisation(&pts);
+        assert!(inv.is_finite() && inv > 0.0);
+        for p in &pts {
+            let v = Vertex::new(*p, centre, inv);
+            for k in 0..3 {
+                let x = v.hi[k] as f64 + v.lo[k] as f64;
+                assert!(x.is_finite() && x.abs() <= 1.0, "{p:?} -> {x}");
+            }
+            assert!(
+                v.hi[0].abs() > 1e-3 || p[0] == centre[0],
+                "{p:?}: {:?}",
+                v.hi
+            );
+        }
+    }
 
     #[test]
     fn hi_lo_split_keeps_f64_precision() {

@@ -102,7 +102,9 @@ pub fn checked<T>(device: &wgpu::Device, what: &str, f: impl FnOnce() -> T) -> R
     let out = f();
     let e1 = pollster::block_on(val.pop());
     let e2 = pollster::block_on(oom.pop());
-    match e1.or(e2) {
+    // Out of memory first: a buffer that could not be allocated makes every later use of it
+    // a validation error, which would hide the cause.
+    match e2.or(e1) {
         Some(e) => Err(GpuError::Device(format!("{what}: {e}"))),
         None => Ok(out),
     }

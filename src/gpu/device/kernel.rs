@@ -383,39 +383,43 @@ impl Kernel {
             };
             last_grid = Some((gx as u32, gy as u32));
 
-            // Upload.
+            // Upload. wgpu's writes report running out of memory (the staging copies) to the
+            // device's error handler, which panics unless a scope takes it.
             let t = Instant::now();
-            queue.write_buffer(params_buf, 0, bytemuck::bytes_of(&params));
-            if local {
-                let planes = batch.local_planes(start..start + count);
-                queue.write_buffer(quad_buf, 0, bytemuck::cast_slice(&planes));
-            } else if whole {
-                if start == 0 {
-                    queue.write_buffer(vertex_buf, 0, bytemuck::cast_slice(&batch.vertices));
-                }
-                queue.write_buffer(quad_buf, 0, bytemuck::cast_slice(quads));
-            } else {
-                local_vertices.clear();
-                local_quads.clear();
-                for q in quads {
-                    local_quads.push(q.map(|v| {
-                        let r = &mut remap[v as usize];
-                        if *r == u32::MAX {
-                            *r = local_vertices.len() as u32;
-                            local_vertices.push(batch.vertices[v as usize]);
-                        }
-                        *r
-                    }));
-                }
-                for q in quads {
-                    for &v in q {
-                        remap[v as usize] = u32::MAX;
+            let upload = checked(device, "uploading the candidates", || {
+                queue.write_buffer(params_buf, 0, bytemuck::bytes_of(&params));
+                if local {
+                    let planes = batch.local_planes(start..start + count);
+                    queue.write_buffer(quad_buf, 0, bytemuck::cast_slice(&planes));
+                } else if whole {
+                    if start == 0 {
+                        queue.write_buffer(vertex_buf, 0, bytemuck::cast_slice(&batch.vertices));
                     }
+                    queue.write_buffer(quad_buf, 0, bytemuck::cast_slice(quads));
+                } else {
+                    local_vertices.clear();
+                    local_quads.clear();
+                    for q in quads {
+                        local_quads.push(q.map(|v| {
+                            let r = &mut remap[v as usize];
+                            if *r == u32::MAX {
+                                *r = local_vertices.len() as u32;
+                                local_vertices.push(batch.vertices[v as usize]);
+                            }
+                            *r
+                        }));
+                    }
+                    for q in quads {
+                        for &v in q {
+                            remap[v as usize] = u32::MAX;
+                        }
+                    }
+                    queue.write_buffer(vertex_buf, 0, bytemuck::cast_slice(&local_vertices));
+                    queue.write_buffer(quad_buf, 0, bytemuck::cast_slice(&local_quads));
                 }
-                queue.write_buffer(vertex_buf, 0, bytemuck::cast_slice(&local_vertices));
-                queue.write_buffer(quad_buf, 0, bytemuck::cast_slice(&local_quads));
-            }
-            queue.submit([]);
+                queue.submit([]);
+            });
+            upload?;
             wait(device)?;
             timings.upload_s += t.elapsed().as_secs_f64();
 
@@ -446,9 +450,11 @@ impl Kernel {
             // Readback.
             let t = Instant::now();
             let bytes = (count * 4) as u64;
-            let mut enc = device.create_command_encoder(&Default::default());
-            enc.copy_buffer_to_buffer(eta_buf, 0, read_buf, 0, bytes);
-            queue.submit([enc.finish()]);
+            checked(device, "copying the results back", || {
+                let mut enc = device.create_command_encoder(&Default::default());
+                enc.copy_buffer_to_buffer(eta_buf, 0, read_buf, 0, bytes);
+                queue.submit([enc.finish()]);
+            })?;
             let data = read_back(device, read_buf, bytes)?;
             out.extend_from_slice(bytemuck::cast_slice::<u8, f32>(&data));
             timings.readback_s += t.elapsed().as_secs_f64();
