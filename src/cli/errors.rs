@@ -48,6 +48,34 @@ pub struct UnusableResultsDir(pub String);
 /// file, or lies under a file (`--out f/sub` named the internal `f/sub/optimum-cache` when
 /// the sweep failed to create it). Names the user's path and the file in the way.
 pub fn check_results_dir(dir: &std::path::Path) -> anyhow::Result<()> {
+    // A symbolic link on the way that leads nowhere (dangling, or a loop): nothing can be
+    // made there, and the sweep would find out only after loading and calibrating.
+    for a in dir.ancestors().filter(|a| !a.as_os_str().is_empty()) {
+        let is_link = std::fs::symlink_metadata(a).is_ok_and(|m| m.file_type().is_symlink());
+        if is_link && let Err(e) = std::fs::metadata(a) {
+            return Err(UnusableResultsDir(format!(
+                "--out {}: {} is a symbolic link that leads nowhere ({e}); choose another --out \
+                 or fix the link",
+                dir.display(),
+                a.display()
+            ))
+            .into());
+        }
+    }
+    // The report's figures go in DIR/figures: a file there would stop it after every run.
+    let figures = dir.join("figures");
+    if let Ok(meta) = std::fs::metadata(&figures)
+        && !meta.is_dir()
+    {
+        return Err(UnusableResultsDir(format!(
+            "--out {}: {} is {}, where the report writes its figures directory; rename or \
+             remove it",
+            dir.display(),
+            figures.display(),
+            quadrecomb::internals::mesh::file_kind(&meta)
+        ))
+        .into());
+    }
     let existing = dir
         .ancestors()
         .filter(|a| !a.as_os_str().is_empty())

@@ -275,9 +275,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     }
     if !out.reproduced {
+        // Name what differs: the search's figures, or (they agree) the finish's.
+        let finish = match (&out.finish, &record.finish) {
+            (Some(f), Some(rf)) if out.quads == record.quads && out.quality == record.quality => {
+                format!(
+                    "; the search agrees, the finish gives {} quads, {} triangles left and \
+                     quality {:.6} where the record has {}, {} and {:.6}",
+                    f.quads, f.triangles_left, f.quality, rf.quads, rf.triangles_left, rf.quality
+                )
+            }
+            _ => String::new(),
+        };
         anyhow::bail!(
             "run {} not reproduced: the replay gives {} quads and quality {:.6} where the \
-             record has {} and {:.6} (eta from {}){}",
+             record has {} and {:.6}{finish} (eta from {}){}",
             record.key(),
             out.quads,
             out.quality,

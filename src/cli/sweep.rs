@@ -321,14 +321,45 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
     // The searches' wall time: from the engine's start of the runs to their end.
     let (mut runs_start, mut runs_end) = (None, None);
-    let (manifest, report, phases) = sweep::run_timed(&config, &CANCEL, &mut |e| {
+    let done = sweep::run_timed(&config, &CANCEL, &mut |e| {
         match e {
             Event::Started { .. } => runs_start = Some(std::time::Instant::now()),
             Event::Finished => runs_end = Some(std::time::Instant::now()),
             _ => {}
         }
         display.event(e)
-    })?;
+    });
+    let (manifest, report, phases) = match done {
+        // Stopped before any run (calibrating): an interruption like one between runs, with
+        // nothing recorded and no run list read yet.
+        Err(quadrecomb::internals::experiment::ExperimentError::Interrupted(why)) => {
+            if args.json {
+                outln!(
+                    "{}",
+                    serde_json::json!({
+                        "out": out,
+                        "runs": null,
+                        "new": 0,
+                        "already_recorded": null,
+                        "cancelled": true,
+                        "shard": args.shard.map(|s| s.to_string()),
+                        "backend": null,
+                        "files": result_files(&out),
+                        "report": null,
+                        "time_s": start.elapsed().as_secs_f64(),
+                        "phases": null,
+                    })
+                );
+            }
+            noteln!(
+                "sweep: {why}; run the same command again to calibrate and run (with {} where \
+                 the directory already held runs)",
+                if args.extend { "--extend" } else { "--resume" }
+            );
+            return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        }
+        r => r?,
+    };
     let searches_s = match (runs_start, runs_end) {
         (Some(a), Some(b)) => b.duration_since(a).as_secs_f64(),
         _ => 0.0,

@@ -437,7 +437,7 @@ pub fn calibrate_spec(
         };
         let mut measure = |knob: u32| -> Result<(Vec<f64>, u64), ExperimentError> {
             if cancel.load(std::sync::atomic::Ordering::SeqCst) {
-                return Err(ExperimentError::Run(
+                return Err(ExperimentError::Interrupted(
                     "interrupted while calibrating the time budgets: no run was made".into(),
                 ));
             }

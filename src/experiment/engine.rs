@@ -157,6 +157,20 @@ pub fn check_records(
                 message: format!("line {line}: run {key}: {why}"),
             }
         })?;
+        if r.backend != manifest.backend || r.version != manifest.version {
+            return Err(ExperimentError::ForeignRecords {
+                dir: path.to_path_buf(),
+                message: format!(
+                    "{}:{line}: run {key} was made by quadrecomb {} with eta from {}, this \
+                     sweep's manifest says quadrecomb {} with eta from {}",
+                    runs.display(),
+                    r.version,
+                    r.backend,
+                    manifest.version,
+                    manifest.backend
+                ),
+            });
+        }
         if r.rule() != manifest.spec.rule() {
             return Err(ExperimentError::ForeignRecords {
                 dir: path.to_path_buf(),
@@ -279,6 +293,30 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
                 r.rule()
             ));
         }
+    }
+    // The mean is the quality per quad (both read off the same eta), and no quad is worse
+    // than the worst.
+    if let Some(mean) = r.mean_eta {
+        if (mean * r.quads as f64 - r.quality).abs() > 1e-6 * r.quality.max(1.0) {
+            return Err(format!(
+                "mean_eta {mean} is not its quality {} over its {} quads",
+                r.quality, r.quads
+            ));
+        }
+        if r.worst_eta.is_some_and(|w| w > mean + 1e-9) {
+            return Err(format!(
+                "worst_eta {:?} is above its mean_eta {mean}",
+                r.worst_eta
+            ));
+        }
+    }
+    if let Some(trees) = r.trees
+        && trees > r.decisions
+    {
+        return Err(format!(
+            "trees {trees} is more than its {} decisions (a tree per decision at most)",
+            r.decisions
+        ));
     }
     for (name, n) in [
         ("quads_eta_below_0_1", r.quads_eta_below_0_1),

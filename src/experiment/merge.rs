@@ -98,6 +98,22 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     // Parts of different configurations (a directory and its extension, or shards of
     // sweeps that add horizons, algorithms or runs to each other) merge into the union of
     // their configurations; the runs they share are the same runs (same seeds).
+    // A time budget calibrated twice into different knobs made different runs under one
+    // name: such parts are not one sweep (the union would keep one calibration and lose the
+    // other's runs).
+    for (i, m) in manifests.iter().enumerate().skip(1) {
+        for (j, earlier) in manifests[..i].iter().enumerate() {
+            if let Some(why) = calibration_conflict(&earlier.spec, &m.spec) {
+                return Err(ExperimentError::Merge(format!(
+                    "{} and {} are not parts of the same sweep: {why} (each calibration makes its \
+                     own runs; merge only parts made from one calibration, such as a directory \
+                     and its --resume or --extend)",
+                    parts[j].display(),
+                    parts[i].display()
+                )));
+            }
+        }
+    }
     let mut spec = first.spec.clone();
     for m in &manifests[1..] {
         spec = super::manifest::union_spec(&spec, &m.spec);
@@ -175,6 +191,16 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
         )));
     }
 
+    // Every record must land in the merged directory: one the union does not plan would be
+    // lost without a word.
+    let planned: std::collections::BTreeSet<RunKey> = jobs.iter().map(|j| j.key(&spec)).collect();
+    if let Some((key, (_, _, i))) = by_key.iter().find(|(k, _)| !planned.contains(k)) {
+        return Err(ExperimentError::Merge(format!(
+            "run {key} of {} is not a run of the union of the parts' configurations, so the \
+             merged directory would lose it",
+            parts[*i].display()
+        )));
+    }
     std::fs::create_dir_all(out).map_err(|e| ExperimentError::io(out, e))?;
     let out_runs = out.join(RUNS_FILE);
     let existing = store::read(&out_runs)?;
@@ -204,6 +230,36 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     Ok(Merged {
         records: records.len(),
         parts: parts.len(),
+    })
+}
+
+/// The first time budget that `a` and `b` calibrated into different knobs (same mesh, method,
+/// given horizon and budget), in words.
+fn calibration_conflict(
+    a: &super::manifest::SweepSpec,
+    b: &super::manifest::SweepSpec,
+) -> Option<String> {
+    use super::plan::has_budget;
+    b.calibration.iter().find_map(|c| {
+        let given = has_budget(&c.algo).then_some(c.horizon);
+        let d = a
+            .calibration
+            .iter()
+            .find(|d| d.is_for(&c.mesh, &c.algo, given, c.time_budget_s))?;
+        let knob = |x: &super::calibrate::Calibrated| match x.budget {
+            Some(n) => format!("node budget {n} at h={}", x.horizon),
+            None => format!("horizon {}", x.horizon),
+        };
+        (d.knob() != c.knob() || d.horizon != c.horizon).then(|| {
+            format!(
+                "they calibrated the time budget {} s of {} on {} differently ({} vs {})",
+                c.time_budget_s.seconds(),
+                c.algo,
+                c.mesh,
+                knob(d),
+                knob(c)
+            )
+        })
     })
 }
 

@@ -179,6 +179,10 @@ pub enum ExperimentError {
     /// A run failed.
     #[error("{0}")]
     Run(String),
+    /// The cancel flag stopped the sweep before its runs began (while calibrating its time
+    /// budgets): nothing was recorded.
+    #[error("{0}")]
+    Interrupted(String),
 }
 
 impl ExperimentError {

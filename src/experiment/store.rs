@@ -71,7 +71,10 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
         let rec: RunRecord =
             serde_json::from_slice(line).map_err(|e| ExperimentError::Corrupt {
                 path: path.to_path_buf(),
-                message: format!("line {}: {e}", n + 1),
+                message: match field_before(line, e.column()) {
+                    Some(field) if e.is_data() => format!("line {}: {field}: {e}", n + 1),
+                    _ => format!("line {}: {e}", n + 1),
+                },
             })?;
         records.push(rec);
         lines.push(String::from_utf8_lossy(line).into_owned());
@@ -84,6 +87,19 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
         valid_len: valid_len as u64,
         torn_bytes: (bytes.len() - valid_len) as u64,
     })
+}
+
+/// The name of the field whose value ends at `column` (1-based, serde_json's position of a
+/// data error) in a record's line: the last `"name":` before it. Serde names the value's
+/// type, not its field.
+fn field_before(line: &[u8], column: usize) -> Option<String> {
+    let text = std::str::from_utf8(line).ok()?;
+    let head = text.get(..column.min(text.len()))?;
+    let colon = head.rfind("\":")?;
+    let start = head[..colon].rfind('"')? + 1;
+    let name = &head[start..colon];
+    (!name.is_empty() && name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_'))
+        .then(|| format!("field {name}"))
 }
 
 /// An open run log that appends one flushed line per record.

@@ -126,6 +126,20 @@ pub use crate::experiment::engine::FIGURES_DIR;
 /// Reads `dir`'s results and writes `dir/report.md`, `dir/report.html` and `dir/figures/*.svg`.
 pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportError> {
     let results = Results::read(dir)?;
+    // Before anything is written: a file where the figures go would stop the report halfway.
+    let fig_dir = dir.join(FIGURES_DIR);
+    if let Ok(meta) = std::fs::metadata(&fig_dir)
+        && !meta.is_dir()
+    {
+        return Err(ReportError::NotResults {
+            dir: dir.to_path_buf(),
+            why: format!(
+                "{FIGURES_DIR} is {}, where the report writes its figures directory: rename or \
+                 remove it",
+                crate::mesh::file_kind(&meta)
+            ),
+        });
+    }
     // The summary follows the runs it is made of (it was left stale after an edit).
     let summary = crate::experiment::summary::write(dir, &results.runs())?;
     let other = match &opts.compare {
@@ -133,7 +147,6 @@ pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportErro
         None => None,
     };
     let doc = build(&results, &summary, other.as_ref(), opts)?;
-    let fig_dir = dir.join(FIGURES_DIR);
     let io = |path: &Path| {
         let path = path.to_path_buf();
         move |source| ReportError::Io { path, source }

@@ -117,6 +117,8 @@ impl Results {
             });
         }
         let path = dir.join(store::RUNS_FILE);
+        // A FIFO, device or directory in its place is named as such.
+        store::refuse_irregular(&path)?;
         if !path.is_file() {
             return Err(ReportError::NotResults {
                 dir: dir.to_path_buf(),

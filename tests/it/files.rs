@@ -1121,3 +1121,108 @@ fn repeated_manifest_entries_and_irregular_files_are_refused() {
         }
     }
 }
+
+#[test]
+fn records_that_contradict_their_manifest_or_themselves_are_refused_naming_the_field() {
+    // Hand-edited records were believed: another backend and version than the manifest's
+    // (a report then said it was made by two versions), a mean eta that is not the quality
+    // per quad; a negative count named no field.
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let out = run_in(dir, &small_sweep_args("s"));
+    assert!(out.status.success(), "{}", stderr(&out));
+    let runs = std::fs::read_to_string(dir.join("s/runs.jsonl")).unwrap();
+    let edit = |field: &str, value: serde_json::Value, name: &str| {
+        let sub = dir.join(name);
+        std::fs::create_dir(&sub).unwrap();
+        std::fs::copy(dir.join("s/manifest.json"), sub.join("manifest.json")).unwrap();
+        let mut lines: Vec<String> = runs.lines().map(String::from).collect();
+        let mut r: serde_json::Value = serde_json::from_str(&lines[1]).unwrap();
+        r[field] = value;
+        lines[1] = r.to_string();
+        std::fs::write(sub.join("runs.jsonl"), lines.join("\n") + "\n").unwrap();
+        run_in(dir, &["report", name, "--no-pictures"])
+    };
+    for (field, value, says) in [
+        (
+            "backend",
+            serde_json::json!("vulkan: fake"),
+            "with eta from vulkan: fake, this sweep's manifest says",
+        ),
+        (
+            "version",
+            serde_json::json!("9.9.9"),
+            "was made by quadrecomb 9.9.9",
+        ),
+        (
+            "mean_eta",
+            serde_json::json!(0.01),
+            "mean_eta 0.01 is not its quality",
+        ),
+        (
+            "nodes_expanded",
+            serde_json::json!(-5),
+            "line 2: field nodes_expanded: invalid value",
+        ),
+    ] {
+        let out = edit(field, value, field);
+        assert_eq!(out.status.code(), Some(3), "{field}: {}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{field}: {}", stderr(&out));
+    }
+}
+
+#[test]
+fn results_paths_that_cannot_work_are_refused_before_any_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // A dangling link and a loop as --out: refused at once (they failed after the runs'
+    // preparation with the system's message).
+    std::os::unix::fs::symlink(dir.join("nowhere/x"), dir.join("dangling")).unwrap();
+    std::os::unix::fs::symlink("loop", dir.join("loop")).unwrap();
+    for out_dir in ["dangling", "loop/sub"] {
+        let mut args = small_sweep_args(out_dir);
+        args.retain(|a| *a != "-q");
+        let out = run_in(dir, &args);
+        assert_eq!(out.status.code(), Some(4), "{out_dir}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("symbolic link that leads nowhere"),
+            "{}",
+            stderr(&out)
+        );
+    }
+    // A file named `figures` where the report writes its figures: refused before the runs
+    // (the sweep ran every run, then failed writing the report).
+    std::fs::create_dir(dir.join("f")).unwrap();
+    std::fs::write(dir.join("f/figures"), "mine").unwrap();
+    let out = run_in(dir, &small_sweep_args("f"));
+    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
+    assert!(!dir.join("f/runs.jsonl").exists());
+    // `report` on a results directory with one: exit 3 naming it, nothing written.
+    let out = run_in(dir, &small_sweep_args("s"));
+    assert!(out.status.success(), "{}", stderr(&out));
+    std::fs::remove_dir_all(dir.join("s/figures")).ok();
+    std::fs::write(dir.join("s/figures"), "mine").unwrap();
+    let out = run_in(dir, &["report", "s"]);
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("figures is a regular file"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("s/figures")).unwrap(),
+        "mine"
+    );
+    // runs.jsonl as a directory: named as such by report and replay.
+    std::fs::remove_file(dir.join("s/runs.jsonl")).unwrap();
+    std::fs::create_dir(dir.join("s/runs.jsonl")).unwrap();
+    for cmd in [vec!["report", "s"], vec!["replay", "s"]] {
+        let out = run_in(dir, &cmd);
+        assert_eq!(out.status.code(), Some(3), "{cmd:?}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("is a directory, not a regular file"),
+            "{}",
+            stderr(&out)
+        );
+    }
+}

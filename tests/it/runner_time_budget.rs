@@ -238,6 +238,91 @@ fn a_killed_time_budget_sweep_resumes_with_its_calibration_and_the_same_records(
 }
 
 #[test]
+fn merge_refuses_parts_that_calibrated_a_time_budget_differently() {
+    // Two sweeps of one configuration whose calibrations chose different horizons (two
+    // machines, or one under load) made different runs under one time budget: merge kept
+    // the first part's calibration and dropped the other's runs without a word.
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 400);
+    let args = |out: &str| {
+        let mut a = sweep_args(&mesh, out, 3, "1");
+        a.extend(["--algo", "selective", "greedy", "--time-budgets", "5ms"].map(String::from));
+        a
+    };
+    let out = sweep(dir, &args("a"), &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    // The other part: the same sweep under another calibration of selective's horizon.
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("a/manifest.json")).unwrap())
+            .unwrap();
+    let mut other = 0;
+    for c in m["spec"]["calibration"].as_array_mut().unwrap() {
+        if c["algo"] == "selective" {
+            let h = c["horizon"].as_u64().unwrap();
+            other = if h > 1 { h - 1 } else { h + 1 };
+            c["horizon"] = other.into();
+        }
+    }
+    assert!(other > 0, "selective was calibrated");
+    std::fs::create_dir(dir.join("b")).unwrap();
+    std::fs::write(dir.join("b/manifest.json"), m.to_string()).unwrap();
+    let out = sweep(dir, &args("b"), &["--resume"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(records(&dir.join("b")).len(), records(&dir.join("a")).len());
+
+    let out = run_in(dir, &["merge", "a", "b", "--out", "merged"]);
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("a and b are not parts of the same sweep")
+            && err.contains("calibrated the time budget 0.005 s of selective")
+            && err.contains(&format!("horizon {other})")),
+        "{err}"
+    );
+    assert!(!dir.join("merged").exists(), "nothing written");
+    // Parts of one calibration still merge.
+    let out = run_in(dir, &["merge", "a", "--out", "alone"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
+fn a_signal_while_calibrating_exits_130_with_the_cancelled_json() {
+    // Stopped before its runs (the pilots of a 3 s budget take seconds), as between runs:
+    // exit 130 and the `cancelled` JSON (it exited 1 with nothing on stdout).
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // A built-in mesh whose pilots at a 3 s budget take seconds (a small grid's saturate
+    // at once).
+    let mut args = sweep_args(std::path::Path::new("borouchaki"), "cal", 3, "1");
+    args.extend(["--algo", "selective", "--time-budgets", "3", "--json"].map(String::from));
+    let child = Command::new(bin())
+        .args(&args)
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let kill = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("interrupted while calibrating the time budgets: no run was made"),
+        "{}",
+        stderr(&out)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["cancelled"], true, "{v}");
+    assert_eq!(v["new"], 0, "{v}");
+    assert!(!dir.join("cal/runs.jsonl").exists(), "no run was made");
+}
+
+#[test]
 fn committed_budget_records_and_manifest_serialise_unchanged() {
     let dir = repo_path("results/budget");
     let text = std::fs::read_to_string(dir.join("runs.jsonl")).unwrap();
