@@ -931,6 +931,8 @@ pub(crate) mod tests {
         let checked = RunRecord {
             quality: 3.0,
             quality_pct: Some(15.0),
+            // The quality per quad.
+            mean_eta: Some(0.75),
             ..r.clone()
         };
         assert_eq!(r.recombined_pct, 80.0);

@@ -182,15 +182,16 @@ pub(crate) mod tests {
         // quads): the records are checked when resumed or merged.
         let triangles = 10 * (job.mesh + 1);
         let quads = (job.seed % 3) as usize + 2;
+        let eta = (job.seed % 100) as f64 / 100.0;
         Outcome {
             quads,
             triangles_left: triangles - 2 * quads,
-            quality: quads as f64 * (job.seed % 100) as f64 / 100.0,
+            quality: quads as f64 * eta,
             nodes_expanded: u64::from(h) * 10 + job.seed % 7,
             trees: 5,
             decisions: 5,
             time_s: 0.001 * f64::from(h),
-            elements: crate::quality::ElementQuality::of([0.5, 0.9]),
+            elements: crate::quality::ElementQuality::of(vec![eta; quads]),
             finish: None,
         }
     }
