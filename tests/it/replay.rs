@@ -242,6 +242,7 @@ fn replay_refuses_what_it_cannot_reproduce() {
     let mut edited = r.clone();
     edited.quality -= 0.25;
     edited.quality_pct = r.quality_pct.map(|p| p * edited.quality / r.quality);
+    edited.mean_eta = r.mean_eta.map(|_| edited.quality / edited.quads as f64);
     std::fs::write(&runs, text.replace(&line, &edited.to_json_line())).unwrap();
     let o = replay(t, &dir, "0", &r, &["-o", "out.msh"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
