@@ -95,9 +95,6 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
             }
         }
     }
-    // Parts of different configurations (a directory and its extension, or shards of
-    // sweeps that add horizons, algorithms or runs to each other) merge into the union of
-    // their configurations; the runs they share are the same runs (same seeds).
     // A time budget calibrated twice into different knobs made different runs under one
     // name: such parts are not one sweep (the union would keep one calibration and lose the
     // other's runs).
@@ -114,6 +111,9 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
             }
         }
     }
+    // Parts of different configurations (a directory and its extension, or shards of
+    // sweeps that add horizons, algorithms or runs to each other) merge into the union of
+    // their configurations; the runs they share are the same runs (same seeds).
     let mut spec = first.spec.clone();
     for m in &manifests[1..] {
         spec = super::manifest::union_spec(&spec, &m.spec);
