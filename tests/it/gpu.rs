@@ -614,6 +614,60 @@ fn launch_shapes_give_identical_results() {
     assert!(err.to_string().contains("invocations here"), "{err}");
 }
 
+/// The 2D grid (a dispatch of more workgroups than one dimension holds: above 16.7 million
+/// candidates on real devices, which lavapipe's dispatch cap does not reach) with the
+/// workgroups per dimension capped: every candidate is evaluated once and in its place, on
+/// both layouts, whole rows and a partial last row, one dispatch and several.
+#[test]
+fn two_dimensional_grids_give_identical_results() {
+    let Some(d) = dev() else { return };
+    let mesh = jittered_grid_mesh(23, 0.3, |x, y| 0.1 * x * y, SEED + 6);
+    let mut batch = Batch::new();
+    batch
+        .push(&mesh.vertices, &CandidateTable::topology_only(&mesh).quads)
+        .unwrap();
+    let n = batch.len();
+    let (indexed, t) = d.kernel.run(&d.device, &d.queue, &batch).unwrap();
+    assert_eq!(t.grid_rows, 1, "{n} candidates fit one row");
+    let (local, _) = d.local.run(&d.device, &d.queue, &batch).unwrap();
+    for layout in [Layout::Indexed, Layout::Local] {
+        let want = if layout == Layout::Indexed {
+            &indexed
+        } else {
+            &local
+        };
+        // (workgroup, groups per dimension, candidates per dispatch): square grids full
+        // and partial, a tall one, chunks with a partial last row.
+        for (workgroup, groups, chunk) in [
+            (4, 7, usize::MAX),
+            (1, 40, usize::MAX),
+            (8, 25, 997),
+            (2, 300, usize::MAX),
+        ] {
+            let options = KernelOptions {
+                layout,
+                workgroup,
+                memory_only: false,
+            };
+            let k = Kernel::with_options(&d.device, options)
+                .unwrap()
+                .with_caps(chunk, usize::MAX)
+                .with_group_cap(groups);
+            let (got, t) = k.run(&d.device, &d.queue, &batch).unwrap();
+            // A dispatch holds at most a square grid of workgroups.
+            let square = (groups * groups * workgroup) as usize;
+            let per_dispatch = chunk.min(n).min(square);
+            let rows = per_dispatch
+                .div_ceil(workgroup as usize)
+                .div_ceil(groups as usize);
+            assert!(rows > 1, "{options}: the grid is 2D");
+            assert_eq!(t.grid_rows, rows, "{options}, {groups} groups per row");
+            assert_eq!(t.dispatches, n.div_ceil(per_dispatch), "{options}");
+            assert_eq!(&got, want, "{options}, {groups} groups per row");
+        }
+    }
+}
+
 #[test]
 fn evaluator_fills_tables_of_many_meshes_on_each_backend() {
     let meshes = [

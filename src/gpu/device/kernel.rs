@@ -22,6 +22,10 @@ pub struct Timings {
     pub readback_s: f64,
     /// Number of dispatches (chunks) the batch needed.
     pub dispatches: usize,
+    /// Workgroup rows of the tallest dispatch grid: 1 unless a dispatch needed more
+    /// workgroups than one dimension holds (then a 2D grid, rows of the per-dimension
+    /// maximum); 0 for an empty batch.
+    pub grid_rows: usize,
 }
 
 impl Timings {
@@ -88,6 +92,7 @@ pub struct Kernel {
     timestamps: bool,
     max_chunk: usize,
     max_vertices: usize,
+    max_groups: usize,
     options: KernelOptions,
     buffers: Mutex<Option<Buffers>>,
 }
@@ -261,6 +266,7 @@ impl Kernel {
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             max_chunk: usize::MAX,
             max_vertices: usize::MAX,
+            max_groups: usize::MAX,
             options,
             buffers: Mutex::new(None),
         })
@@ -271,6 +277,14 @@ impl Kernel {
     pub fn with_caps(mut self, max_chunk: usize, max_vertices: usize) -> Kernel {
         self.max_chunk = max_chunk.max(1);
         self.max_vertices = max_vertices;
+        self
+    }
+
+    /// Caps the workgroups per grid dimension below the device's
+    /// `max_compute_workgroups_per_dimension` (at least 1), so that tests reach the 2D
+    /// grid, which the device's limit puts above 16.7 million candidates per dispatch.
+    pub fn with_group_cap(mut self, groups_per_dimension: u32) -> Kernel {
+        self.max_groups = groups_per_dimension.max(1) as usize;
         self
     }
 
@@ -300,7 +314,7 @@ impl Kernel {
         let bind_max = limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size) as usize;
-        let wg_max = limits.max_compute_workgroups_per_dimension as usize;
+        let wg_max = (limits.max_compute_workgroups_per_dimension as usize).min(self.max_groups);
         let local = self.options.layout == Layout::Local;
         let wg = self.options.workgroup as usize;
         let whole = local
@@ -382,6 +396,7 @@ impl Kernel {
                 plane: count as u32,
             };
             last_grid = Some((gx as u32, gy as u32));
+            timings.grid_rows = timings.grid_rows.max(gy);
 
             // Upload. wgpu's writes report running out of memory (the staging copies) to the
             // device's error handler, which panics unless a scope takes it.
