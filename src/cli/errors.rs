@@ -8,7 +8,7 @@
 //! | 2 | usage error: an unknown flag or a value it refuses (clap), a value out of range |
 //! | 3 | bad input: a mesh file unreadable or invalid, a results directory whose files are corrupt or do not form one sweep |
 //! | 4 | the results directory cannot be used: it holds other runs or another configuration, another sweep is writing it, or it is not a directory or lies under a file |
-//! | 5 | out of memory ([`super::oom`]) |
+//! | 5 | out of memory ([`super::oom`]; the GPU's too: [`GpuError::OutOfMemory`]) |
 //! | 130 | interrupted (Ctrl-C, SIGTERM or SIGHUP) |
 
 use std::error::Error;
@@ -118,6 +118,9 @@ fn code(e: &(dyn Error + 'static)) -> Option<u8> {
     {
         return Some(EXIT_BAD_INPUT);
     }
+    if let Some(GpuError::OutOfMemory(_)) = e.downcast_ref::<GpuError>() {
+        return Some(EXIT_OUT_OF_MEMORY);
+    }
     if let Some(e) = e.downcast_ref::<ExperimentError>() {
         return experiment_code(e);
     }
@@ -182,6 +185,11 @@ fn flag_wording(e: &(dyn Error + 'static)) -> Option<String> {
              mesa-vulkan-drivers, or use --backend cpu)"
                 .into(),
         );
+    }
+    if let Some(e @ GpuError::OutOfMemory(_)) = e.downcast_ref::<GpuError>() {
+        return Some(format!(
+            "{e}; --backend cpu computes the qualities on the CPU (the kernel's f32 twin)"
+        ));
     }
     use ExperimentError as E;
     Some(match e.downcast_ref::<ExperimentError>()? {
@@ -279,5 +287,21 @@ mod tests {
             "{}",
             describe(&e)
         );
+    }
+
+    #[test]
+    fn gpu_out_of_memory_is_exit_5_and_names_the_way_out() {
+        let oom = GpuError::OutOfMemory("uploading 9 candidates (wgpu: Out of Memory)".into());
+        let e = anyhow::Error::new(ExperimentError::Gpu(oom));
+        assert_eq!(exit_code(&e), EXIT_OUT_OF_MEMORY);
+        assert_eq!(
+            describe(&e),
+            "computing quad qualities: out of GPU memory while uploading 9 candidates (wgpu: \
+             Out of Memory); --backend cpu computes the qualities on the CPU (the kernel's f32 \
+             twin)"
+        );
+        let other = GpuError::Device("running the quality kernel: lost".into());
+        let e = anyhow::Error::new(ExperimentError::Gpu(other));
+        assert_eq!(exit_code(&e), EXIT_FAILURE);
     }
 }

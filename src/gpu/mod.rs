@@ -52,7 +52,7 @@ impl std::fmt::Display for Backend {
 
 /// Errors of the GPU path. [`GpuError::NoAdapter`] and [`GpuError::RequestDevice`] are the
 /// environment's (no driver); [`GpuError::Shader`] and [`GpuError::Device`] are bugs or
-/// device failures; [`GpuError::BadIndex`] and [`GpuError::TooLarge`] are the caller's input.
+/// device failures, [`GpuError::OutOfMemory`] the device's or the host's memory; [`GpuError::BadIndex`] and [`GpuError::TooLarge`] are the caller's input.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
     /// No Vulkan adapter: install a GPU driver, or lavapipe (Debian: mesa-vulkan-drivers),
@@ -68,9 +68,13 @@ pub enum GpuError {
     /// The WGSL source does not parse or validate (message rendered with spans by naga).
     #[error("shader {path} is invalid:\n{message}")]
     Shader { path: String, message: String },
-    /// A wgpu validation, out-of-memory or device-lost error while running the kernel.
+    /// A wgpu validation or device-lost error while running the kernel.
     #[error("GPU error: {0}")]
     Device(String),
+    /// The device (or the driver's host-side staging) could not allocate what the kernel's
+    /// buffers or transfers need: what was being done, and wgpu's message.
+    #[error("out of GPU memory while {0}")]
+    OutOfMemory(String),
     /// A candidate refers to a vertex the mesh does not have.
     #[error(
         "candidate {candidate} of mesh {mesh} in the batch refers to vertex {vertex}, \

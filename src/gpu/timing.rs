@@ -94,8 +94,8 @@ impl Timestamps {
     }
 }
 
-/// Runs `f`, turning any wgpu validation or out-of-memory error it raises into a
-/// [`GpuError::Device`].
+/// Runs `f`, turning a wgpu out-of-memory error it raises into a
+/// [`GpuError::OutOfMemory`] and a validation error into a [`GpuError::Device`].
 pub fn checked<T>(device: &wgpu::Device, what: &str, f: impl FnOnce() -> T) -> Result<T, GpuError> {
     let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
     let val = device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -104,7 +104,10 @@ pub fn checked<T>(device: &wgpu::Device, what: &str, f: impl FnOnce() -> T) -> R
     let e2 = pollster::block_on(oom.pop());
     // Out of memory first: a buffer that could not be allocated makes every later use of it
     // a validation error, which would hide the cause.
-    match e2.or(e1) {
+    if let Some(e) = e2 {
+        return Err(GpuError::OutOfMemory(format!("{what} (wgpu: {e})")));
+    }
+    match e1 {
         Some(e) => Err(GpuError::Device(format!("{what}: {e}"))),
         None => Ok(out),
     }

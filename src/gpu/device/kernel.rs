@@ -348,7 +348,12 @@ impl Kernel {
             .is_none_or(|b| b.vertex_cap < vertex_cap || b.chunk < chunk)
         {
             *cache = None; // free the old ones first
-            *cache = Some(checked(device, "allocating buffers", || {
+            let bytes = vertex_cap * VERTEX_BYTES + chunk * (per_candidate + 8);
+            let what = format!(
+                "allocating its buffers ({}: {chunk} candidates, {vertex_cap} vertices)",
+                mib(bytes)
+            );
+            *cache = Some(checked(device, &what, || {
                 Buffers::new(
                     device,
                     &self.layout,
@@ -401,7 +406,8 @@ impl Kernel {
             // Upload. wgpu's writes report running out of memory (the staging copies) to the
             // device's error handler, which panics unless a scope takes it.
             let t = Instant::now();
-            let upload = checked(device, "uploading the candidates", || {
+            let what = format!("uploading {count} candidates");
+            let upload = checked(device, &what, || {
                 queue.write_buffer(params_buf, 0, bytemuck::bytes_of(&params));
                 if local {
                     let planes = batch.local_planes(start..start + count);
@@ -465,7 +471,7 @@ impl Kernel {
             // Readback.
             let t = Instant::now();
             let bytes = (count * 4) as u64;
-            checked(device, "copying the results back", || {
+            checked(device, &format!("copying {count} results back"), || {
                 let mut enc = device.create_command_encoder(&Default::default());
                 enc.copy_buffer_to_buffer(eta_buf, 0, read_buf, 0, bytes);
                 queue.submit([enc.finish()]);
@@ -511,4 +517,9 @@ impl Kernel {
             warm_up,
         )
     }
+}
+
+/// `bytes` in MiB, for messages.
+fn mib(bytes: usize) -> String {
+    format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0))
 }
