@@ -564,22 +564,25 @@ fn chunked_dispatches_and_vertex_compaction_give_identical_results() {
     assert!(empty.is_empty());
 }
 
-#[test]
-fn launch_shapes_give_identical_results() {
-    let Some(d) = dev() else { return };
-    let mesh = jittered_grid_mesh(23, 0.3, |x, y| 0.1 * x * y, SEED + 5);
+/// The candidates of a 23 x 23 jittered grid, and the default kernel's eta on each layout
+/// (one dispatch, one row): what other launch shapes must reproduce bit for bit.
+fn grid_batch(d: &Dev, seed: u64) -> (Batch, [(Layout, Vec<f32>); 2]) {
+    let mesh = jittered_grid_mesh(23, 0.3, |x, y| 0.1 * x * y, seed);
     let mut batch = Batch::new();
     batch
         .push(&mesh.vertices, &CandidateTable::topology_only(&mesh).quads)
         .unwrap();
     let (indexed, _) = d.kernel.run(&d.device, &d.queue, &batch).unwrap();
     let (local, _) = d.local.run(&d.device, &d.queue, &batch).unwrap();
-    for layout in [Layout::Indexed, Layout::Local] {
-        let want = if layout == Layout::Indexed {
-            &indexed
-        } else {
-            &local
-        };
+    (batch, [(Layout::Indexed, indexed), (Layout::Local, local)])
+}
+
+#[test]
+fn launch_shapes_give_identical_results() {
+    let Some(d) = dev() else { return };
+    let (batch, references) = grid_batch(d, SEED + 5);
+    for (layout, want) in &references {
+        let layout = *layout;
         // Workgroup sizes that leave partial last workgroups; chunks of 997
         // candidates (a prime) make every chunk's tail differ.
         for (workgroup, chunk) in [(64, usize::MAX), (32, usize::MAX), (128, 997), (1, 997)] {
@@ -621,21 +624,12 @@ fn launch_shapes_give_identical_results() {
 #[test]
 fn two_dimensional_grids_give_identical_results() {
     let Some(d) = dev() else { return };
-    let mesh = jittered_grid_mesh(23, 0.3, |x, y| 0.1 * x * y, SEED + 6);
-    let mut batch = Batch::new();
-    batch
-        .push(&mesh.vertices, &CandidateTable::topology_only(&mesh).quads)
-        .unwrap();
+    let (batch, references) = grid_batch(d, SEED + 6);
     let n = batch.len();
-    let (indexed, t) = d.kernel.run(&d.device, &d.queue, &batch).unwrap();
+    let (_, t) = d.kernel.run(&d.device, &d.queue, &batch).unwrap();
     assert_eq!(t.grid_rows, 1, "{n} candidates fit one row");
-    let (local, _) = d.local.run(&d.device, &d.queue, &batch).unwrap();
-    for layout in [Layout::Indexed, Layout::Local] {
-        let want = if layout == Layout::Indexed {
-            &indexed
-        } else {
-            &local
-        };
+    for (layout, want) in &references {
+        let layout = *layout;
         // (workgroup, groups per dimension, candidates per dispatch): square grids full
         // and partial, a tall one, chunks with a partial last row.
         for (workgroup, groups, chunk) in [
