@@ -38,6 +38,9 @@ struct Info {
     boundary_edges: usize,
     /// Edges of three or more elements: where surfaces meet (shell models).
     junction_edges: usize,
+    /// Edges between two triangles of one surface on which a line element of the input lies
+    /// (an embedded curve, a closed surface's seam): no quad is made across them.
+    curve_edges: usize,
     /// Element nodes at exactly the position of another element node (distinct tags): the
     /// elements there are not joined, the mesh has a crack (surfaces meshed apart, not
     /// merged). Each node beyond the first at a position counts.
@@ -146,6 +149,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             odd_components: 0,
             boundary_edges,
             junction_edges,
+            curve_edges: 0,
             coincident_nodes,
             candidate_pairs: 0,
             valid_pairs: 0,
@@ -187,6 +191,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         odd_components: topo.component_sizes.iter().filter(|&&s| s % 2 == 1).count(),
         boundary_edges: topo.num_boundary_edges,
         junction_edges: topo.num_junction_edges,
+        curve_edges: topo.num_curve_edges,
         coincident_nodes: coincident(
             &m.vertices,
             m.triangles.iter().flatten().chain(m.quads.iter().flatten()),
@@ -270,6 +275,14 @@ fn text(i: &Info) -> String {
             s,
             "junction edges:       {} (three or more elements: surfaces meet there)",
             i.junction_edges
+        );
+    }
+    if i.curve_edges > 0 {
+        wln!(
+            s,
+            "curve edges:          {} (inside a surface, on a line element: an embedded curve or \
+             a seam; no quad is made across them)",
+            i.curve_edges
         );
     }
     if i.coincident_nodes > 0 {

@@ -20,6 +20,10 @@ pub struct Topology {
     pub num_boundary_edges: usize,
     /// Number of edges used by three or more elements (surfaces meeting there).
     pub num_junction_edges: usize,
+    /// Number of edges between two triangles of one surface that a line element of the
+    /// input lies on (an embedded curve, the seam of a closed surface): the triangles are
+    /// not neighbours there, so no quad straddles a model curve.
+    pub num_curve_edges: usize,
     /// Number of triangles in each connected component of the dual graph, the components
     /// numbered in order of their first triangle.
     pub component_sizes: Vec<u32>,
@@ -292,8 +296,16 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             data.quad_surface[e - nt]
         }
     };
+    // The sides of the model's 2-node line elements (sorted vertex pairs).
+    let mut curve_sides: Vec<(u32, u32)> = (data.model.iter())
+        .flat_map(|m| &m.elements)
+        .filter(|e| e.dim == 1 && e.nodes.len() == 2)
+        .map(|e| (e.nodes[0].min(e.nodes[1]), e.nodes[0].max(e.nodes[1])))
+        .collect();
+    curve_sides.sort_unstable();
     let mut neighbours = vec![[NONE; 3]; nt];
     let (mut num_edges, mut num_boundary_edges, mut num_junction_edges) = (0, 0, 0);
+    let mut curve_pairs: Vec<(u32, u32)> = Vec::new();
     for (a, b, group) in half.groups() {
         if overfull_surface(group, surface_of).is_some() {
             return Err(half.non_manifold(&data.vertex_ids, element_id, surface_of));
@@ -302,21 +314,28 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
         num_boundary_edges += usize::from(group.len() == 1);
         num_junction_edges += usize::from(group.len() > 2);
         let side = |t: u32| side_of(data.triangles[t as usize], a, b);
-        // Two triangles of one surface on the edge are neighbours (at most two per surface).
+        let on_curve = curve_sides.binary_search(&(a, b)).is_ok();
+        // Two triangles of one surface on the edge are neighbours (at most two per surface),
+        // unless a line element of the input lies on it.
         for (i, &(_, t)) in group.iter().enumerate() {
             for &(_, u) in &group[i + 1..] {
                 let (ti, ui) = (t as usize, u as usize);
                 if ti < nt && ui < nt && surface_of(t) == surface_of(u) {
                     neighbours[ti][side(t)] = u;
                     neighbours[ui][side(u)] = t;
+                    if on_curve {
+                        curve_pairs.push((t, u));
+                    }
                 }
             }
         }
     }
     drop(half);
 
-    // Components, and consistent orientation within each (flip[t] = reverse t).
-    let (component, component_sizes, mut flip) =
+    // Components, and consistent orientation within each (flip[t] = reverse t). Oriented
+    // across the model's curves too, so that both sides of an embedded curve or a seam keep
+    // one orientation.
+    let (component, mut component_sizes, mut flip) =
         match orient(&data.triangles, &neighbours, 0..nt as u32) {
             Ok(o) => o,
             Err(_) => {
@@ -347,6 +366,21 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             flip[t] = !flip[t];
         }
     }
+    // Then the sides on a model curve part: the dual graph's components are counted without
+    // them (a closed curve encloses a component of its own).
+    for &(t, u) in &curve_pairs {
+        for (a, b) in [(t, u), (u, t)] {
+            let n = &mut neighbours[a as usize];
+            if let Some(k) = n.iter().position(|&x| x == b) {
+                n[k] = NONE;
+            }
+        }
+    }
+    if !curve_pairs.is_empty() {
+        component_sizes = orient(&data.triangles, &neighbours, 0..nt as u32)
+            .expect("a part of an orientable dual graph is orientable")
+            .1;
+    }
     let mut reoriented = 0;
     for t in 0..nt {
         if flip[t] {
@@ -373,6 +407,7 @@ pub(super) fn build(mut data: MeshData) -> Result<Mesh, MeshError> {
             neighbours,
             num_boundary_edges,
             num_junction_edges,
+            num_curve_edges: curve_pairs.len(),
             component_sizes,
         },
     })
@@ -629,6 +664,46 @@ mod tests {
         mesh.sanity_check().unwrap();
         assert_eq!(mesh.topology.num_dual_edges(), 0);
         assert_eq!(mesh.topology.component_sizes, vec![1, 1]);
+    }
+
+    /// A line element on the diagonal (an embedded curve): the two triangles are not
+    /// neighbours, each is a component, and an inconsistent orientation is still fixed
+    /// across the curve. A line on a boundary side or on no side changes nothing.
+    #[test]
+    fn triangles_are_not_neighbours_across_a_line_element() {
+        use crate::mesh::msh::{Element, Model};
+        let line = |a: u32, b: u32| Element {
+            gmsh_type: 1,
+            dim: 1,
+            entity: 7,
+            nodes: vec![a, b],
+        };
+        for second in [[0, 2, 3], [0, 3, 2]] {
+            let mut data = square(second);
+            data.model = Some(Box::new(Model {
+                elements: vec![line(2, 0), line(0, 1)],
+                ..Model::default()
+            }));
+            let mesh = Mesh::new(data).unwrap();
+            mesh.sanity_check().unwrap();
+            assert_eq!(mesh.topology.num_dual_edges(), 0);
+            assert_eq!(mesh.topology.num_curve_edges, 1);
+            assert_eq!(mesh.topology.component_sizes, vec![1, 1]);
+            assert_eq!(mesh.reoriented, usize::from(second == [0, 3, 2]));
+            let [a, b] = [mesh.triangles[0], mesh.triangles[1]];
+            // Consistent: the diagonal runs 2 -> 0 in one and 0 -> 2 in the other.
+            let runs =
+                |t: [u32; 3], p: u32, q: u32| (0..3).any(|i| t[i] == p && t[(i + 1) % 3] == q);
+            assert!(runs(a, 2, 0) != runs(b, 2, 0), "{a:?} {b:?}");
+        }
+        let mut data = square([0, 2, 3]);
+        data.model = Some(Box::new(Model {
+            elements: vec![line(0, 1), line(1, 3)],
+            ..Model::default()
+        }));
+        let mesh = Mesh::new(data).unwrap();
+        assert_eq!(mesh.topology.num_dual_edges(), 1);
+        assert_eq!(mesh.topology.num_curve_edges, 0);
     }
 
     /// The message names the same edge and elements whatever the order of the nodes and

@@ -227,3 +227,37 @@ counts = [len(gmsh.model.mesh.getElements(2, s)[1][0]) for _, s in gmsh.model.ge
 assert all(n % 2 == 1 for n in counts), counts
 write("disk_nolines_41_ascii.msh", 4.1, 0)
 gmsh.finalize()
+
+# Curves inside a surface, both sides of them on that surface (tests/it/model.rs): a square
+# with an embedded crack (a polyline), an embedded circle and an embedded point, named groups
+# for the plate, the crack, the circle and the outer boundary; and the shell of a cylinder,
+# whose side surface meets itself along its seam curve (no groups: Gmsh saves every element,
+# the seam's lines too). No quad may straddle those curves: their segments stay element sides.
+start("crack")
+occ = gmsh.model.occ
+plate = occ.addRectangle(0, 0, 0, 1, 1)
+pts = [occ.addPoint(x, y, 0) for x, y in [(0.2, 0.3), (0.45, 0.42), (0.6, 0.61), (0.8, 0.7)]]
+crack = [occ.addLine(pts[i], pts[i + 1]) for i in range(3)]
+circle = occ.addCircle(0.3, 0.75, 0, 0.12)
+tip = occ.addPoint(0.75, 0.2, 0)
+occ.synchronize()
+gmsh.model.mesh.embed(1, crack + [circle], 2, plate)
+gmsh.model.mesh.embed(0, [tip], 2, plate)
+gmsh.model.addPhysicalGroup(2, [plate], name="plate")
+gmsh.model.addPhysicalGroup(1, crack, name="crack")
+gmsh.model.addPhysicalGroup(1, [circle], name="circle")
+gmsh.model.addPhysicalGroup(1, [c for _, c in gmsh.model.getBoundary([(2, plate)])], name="boundary")
+gmsh.model.addPhysicalGroup(0, [tip], name="tip")
+mesh(0.07)
+write("crack_41_ascii.msh", 4.1, 0)
+write("crack_22_ascii.msh", 2.2, 0)
+gmsh.finalize()
+
+start("cylinder")
+occ = gmsh.model.occ
+occ.addCylinder(0, 0, 0, 0, 0, 1, 0.5)
+occ.synchronize()
+gmsh.model.removeEntities(gmsh.model.getEntities(3))
+mesh(0.15)
+write("cylinder_41_ascii.msh", 4.1, 0)
+gmsh.finalize()
