@@ -28,8 +28,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     super::check_mesh_output(args.out.output.as_deref())?;
     let rule = args.rule.rule()?;
     super::check_not_input(args.out.output.as_deref(), &args.mesh)?;
+    use super::oom::{self, Phase};
+    oom::phase(Phase::Reading);
     let mesh = quadrecomb::internals::mesh::load(&args.mesh)?;
+    oom::mesh_size(mesh.num_triangles());
+    oom::phase(Phase::Candidates);
     let table = CandidateTable::build(&mesh).restrict(&mesh, rule);
+    oom::phase(Phase::Optimum);
     let (opt, report) = optimum::solve_certified(&mesh, &table, args.check);
     let nt = mesh.num_triangles();
     let elements = ElementQuality::of_chosen(&table, &opt.chosen);
@@ -44,6 +49,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         None => None,
     };
     // A failed write is reported after the figures, which are printed all the same.
+    oom::phase(Phase::Writing);
     let written = args.out.output.as_ref().map(|path| {
         super::write_mesh_output(
             path,

@@ -196,7 +196,12 @@ impl Progress {
             return;
         }
         if let Some(bar) = self.bar.take() {
+            // Left drawn (its last figures), the cursor at the end of its line: end the line,
+            // or the summary that follows runs into it.
             bar.abandon();
+            if !bar.is_hidden() {
+                noteln!();
+            }
         }
         if let Some(t) = self.ticker.take() {
             *self.shared.stop.lock().unwrap_or_else(|p| p.into_inner()) = true;

@@ -72,8 +72,10 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
             serde_json::from_slice(line).map_err(|e| ExperimentError::Corrupt {
                 path: path.to_path_buf(),
                 message: match field_before(line, e.column()) {
-                    Some(field) if e.is_data() => format!("line {}: {field}: {e}", n + 1),
-                    _ => format!("line {}: {e}", n + 1),
+                    Some(field) if e.is_data() => {
+                        format!("line {}: {field}: {}", n + 1, at_column(&e))
+                    }
+                    _ => format!("line {}: {}", n + 1, at_column(&e)),
                 },
             })?;
         records.push(rec);
@@ -87,6 +89,18 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
         valid_len: valid_len as u64,
         torn_bytes: (bytes.len() - valid_len) as u64,
     })
+}
+
+/// serde_json's message with its position as a column of the record's line: it counts
+/// lines within the one record it was given ("... at line 1 column 19"), which read beside
+/// the file's line number as another line.
+fn at_column(e: &serde_json::Error) -> String {
+    let text = e.to_string();
+    let suffix = format!(" at line {} column {}", e.line(), e.column());
+    match text.strip_suffix(&suffix) {
+        Some(head) if e.line() == 1 => format!("{head} at column {}", e.column()),
+        _ => text,
+    }
 }
 
 /// The name of the field whose value ends at `column` (1-based, serde_json's position of a
@@ -244,9 +258,17 @@ pub(crate) mod tests {
         let path = dir.path().join(RUNS_FILE);
         let mut text = record(0).to_json_line();
         text.push_str("\n{\"mesh\": 1}\n");
-        std::fs::write(&path, text).unwrap();
+        std::fs::write(&path, &text).unwrap();
         let err = read(&path).unwrap_err().to_string();
         assert!(err.contains("line 2"), "{err}");
+        // A syntax error names its column, not serde's line within the record.
+        text.push_str("{\"mesh\":\"sphere\", broken\n");
+        std::fs::write(&path, text.replace("{\"mesh\": 1}\n", "")).unwrap();
+        let err = read(&path).unwrap_err().to_string();
+        assert!(
+            err.ends_with("line 2: key must be a string at column 19"),
+            "{err}"
+        );
     }
 
     #[test]

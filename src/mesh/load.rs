@@ -61,6 +61,20 @@ pub fn source(spec: &str) -> Result<Source, ReadError> {
                 bytes: Cow::Borrowed(bytes),
             });
         }
+        // A bare word (no directory, no extension) was most likely meant as a name.
+        if !spec.contains(['/', '.', '\\']) && !spec.is_empty() {
+            return Err(ReadError::Io {
+                path: path.to_path_buf(),
+                source: std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    format!(
+                        "no such file, nor a built-in mesh ({}) or a benchmark suite's mesh \
+                         (suite:NAME, listed by `quadrecomb suite list`)",
+                        builtin::NAMES.join(", ")
+                    ),
+                ),
+            });
+        }
     }
     let bytes = read_file(path)?;
     Ok(Source {

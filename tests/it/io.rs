@@ -567,6 +567,15 @@ fn bad_input_missing_file() {
         1,
         "cause repeated: {err}"
     );
+    // A bare word is taken for a mistyped name: the message lists the names.
+    let err = assert_bad(
+        Path::new("spheres"),
+        &["spheres: no such file, nor a built-in mesh"],
+    );
+    assert!(
+        err.contains("(borouchaki, sphere)") && err.contains("quadrecomb suite list"),
+        "{err}"
+    );
 }
 
 #[test]
