@@ -87,11 +87,12 @@ pub fn attach(searcher: &mut Searcher<'_>, horizon: Option<u32>) -> ProgressBar 
     searcher.set_progress(move |p| {
         // Estimated at every report once the run has lasted a second (the later trees can
         // be the larger ones), said once.
-        if !warned && p.elapsed_s >= ESTIMATE_AFTER_S {
-            if let Some(w) = cost_warning(p, horizon) {
-                warned = true;
-                shown.suspend(|| noteln!("{w}"));
-            }
+        if !warned
+            && p.elapsed_s >= ESTIMATE_AFTER_S
+            && let Some(w) = cost_warning(p, horizon)
+        {
+            warned = true;
+            shown.suspend(|| noteln!("{w}"));
         }
         if p.elapsed_s < BAR_AFTER_S {
             return;

@@ -287,10 +287,10 @@ pub fn search_knobs<E>(
             if hi.is_some_and(|h| h.0 == min) {
                 break; // even the smallest knob is too slow
             }
-            if let (Some(l), Some(h)) = (lo, hi) {
-                if h.0 <= l.0 + 1 {
-                    break;
-                }
+            if let (Some(l), Some(h)) = (lo, hi)
+                && h.0 <= l.0 + 1
+            {
+                break;
             }
             let next = match (kind, lo, hi) {
                 (KnobKind::Nodes, None, None) => 16.clamp(min, top),

@@ -326,22 +326,22 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             return Err(format!("{name} {n:?} is more than its {} quads", r.quads));
         }
     }
-    if let Some(pct) = r.quality_pct {
-        if !pct.is_finite() || pct < 0.0 {
-            return Err(format!(
-                "quality_pct {pct} is not a finite non-negative number"
-            ));
-        }
+    if let Some(pct) = r.quality_pct
+        && (!pct.is_finite() || pct < 0.0)
+    {
+        return Err(format!(
+            "quality_pct {pct} is not a finite non-negative number"
+        ));
     }
     if let Some(f) = &r.finish {
         f.check(r.triangles)?;
-        if let Some(opt) = optimum {
-            if f.quads > opt.quads + f.triangles_added() {
-                return Err(format!(
-                    "finish: {} quads, more than the {} of its mesh's optimum",
-                    f.quads, opt.quads
-                ));
-            }
+        if let Some(opt) = optimum
+            && f.quads > opt.quads + f.triangles_added()
+        {
+            return Err(format!(
+                "finish: {} quads, more than the {} of its mesh's optimum",
+                f.quads, opt.quads
+            ));
         }
     }
     let Some(opt) = optimum else {

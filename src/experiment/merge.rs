@@ -33,13 +33,13 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     if parts.is_empty() {
         return Err(ExperimentError::Merge("no directories to merge".into()));
     }
-    if let Ok(meta) = std::fs::metadata(out) {
-        if !meta.is_dir() {
-            return Err(ExperimentError::NotADirectory {
-                dir: out.to_path_buf(),
-                kind: crate::mesh::file_kind(&meta).to_string(),
-            });
-        }
+    if let Ok(meta) = std::fs::metadata(out)
+        && !meta.is_dir()
+    {
+        return Err(ExperimentError::NotADirectory {
+            dir: out.to_path_buf(),
+            kind: crate::mesh::file_kind(&meta).to_string(),
+        });
     }
     let mut manifests = Vec::new();
     for p in parts {

@@ -174,23 +174,21 @@ pub fn cached_optimum(
     let text = (!recompute)
         .then(|| std::fs::read_to_string(&path).ok())
         .flatten();
-    if let Some(text) = text {
-        if let Ok(cached) = serde_json::from_str::<CachedOptimum>(&text) {
-            if cached.optimum.mesh_hash == entry.hash
-                && cached.optimum.eta_hash == eta
-                && cached.verify(mesh, table)
-            {
-                return Ok(OptimumEntry {
-                    mesh: entry.name.clone(),
-                    // JSON parsing of floats may be off by an ulp: restore the exact value,
-                    // so that quality_pct is bit-identical whether the optimum was cached.
-                    quality: f64::from_bits(cached.quality_bits),
-                    // From the verified matching, bit for bit as when it was solved.
-                    elements: ElementQuality::of_chosen(table, &cached.chosen),
-                    ..cached.optimum
-                });
-            }
-        }
+    if let Some(text) = text
+        && let Ok(cached) = serde_json::from_str::<CachedOptimum>(&text)
+        && cached.optimum.mesh_hash == entry.hash
+        && cached.optimum.eta_hash == eta
+        && cached.verify(mesh, table)
+    {
+        return Ok(OptimumEntry {
+            mesh: entry.name.clone(),
+            // JSON parsing of floats may be off by an ulp: restore the exact value,
+            // so that quality_pct is bit-identical whether the optimum was cached.
+            quality: f64::from_bits(cached.quality_bits),
+            // From the verified matching, bit for bit as when it was solved.
+            elements: ElementQuality::of_chosen(table, &cached.chosen),
+            ..cached.optimum
+        });
     }
     let opt = crate::search::optimum::solve(mesh, table);
     let found = OptimumEntry {

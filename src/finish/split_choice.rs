@@ -95,7 +95,7 @@ impl std::fmt::Display for Stuck {
             StuckReason::TooManyLeft => write!(
                 f,
                 "{}, and one boundary split adds a triangle and lowers what must stay by at most one",
-                if self.size % 2 == 0 {
+                if self.size.is_multiple_of(2) {
                     "it is even but has no perfect matching"
                 } else {
                     "more than its parity asks"

@@ -41,12 +41,12 @@ pub(super) fn box_plots(
                 })
                 .collect();
             let mut extras = Extras::default();
-            if let Some((g, gr)) = greedy {
-                if metric.name(gr) == name {
-                    extras
-                        .baselines
-                        .push((g.label(), metric_median(summary, g, gr, metric)));
-                }
+            if let Some((g, gr)) = greedy
+                && metric.name(gr) == name
+            {
+                extras
+                    .baselines
+                    .push((g.label(), metric_median(summary, g, gr, metric)));
             }
             let mut caption = format!(
                 "{mesh}, {algo}: {name} against horizon ({} runs per horizon). Red lines: medians; \

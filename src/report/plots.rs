@@ -390,10 +390,10 @@ fn tag_boxes(svg: &str, boxes: &[HorizonBox], prefix: &str) -> String {
         let end = rest[i..].find("/>").map_or(rest.len(), |e| i + e);
         out.push_str(&rest[..i]);
         out.push_str("<rect ");
-        if rest[i..end].contains(&fill) {
-            if let Some(b) = next.next() {
-                out.push_str(&format!("id=\"{prefix}box-h{}\" ", b.horizon));
-            }
+        if rest[i..end].contains(&fill)
+            && let Some(b) = next.next()
+        {
+            out.push_str(&format!("id=\"{prefix}box-h{}\" ", b.horizon));
         }
         rest = &rest[i + "<rect ".len()..];
     }

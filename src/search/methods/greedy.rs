@@ -67,7 +67,7 @@ impl Searcher<'_> {
             }
             self.state.apply_lazy(next);
             let quads = self.state.quads();
-            if quads % 4096 == 0 {
+            if quads.is_multiple_of(4096) {
                 self.tick(quads);
             }
             let fresh = self.state.dirty_since(seen);

@@ -382,7 +382,7 @@ mod tests {
                 }
                 _ => {
                     let keep = next(o.len() as u64 + 1) as usize;
-                    let live = |e: Entry| e.1 % 3 != 0;
+                    let live = |e: Entry| !e.1.is_multiple_of(3);
                     lists.retain_from(i, keep, live);
                     let mut k = 0;
                     o.retain(|&e| {

@@ -142,12 +142,12 @@ impl ModelParts {
         if !self.parents.is_empty() {
             let parents = &self.parents;
             for (v, on) in self.node_entity.iter_mut().enumerate() {
-                if let Some((dim, tag)) = *on {
-                    if let Some(&(pd, pt)) = parents.get(&(dim, tag)) {
-                        *on = Some((pd, pt));
-                        if let (true, Some(param)) = (pd != dim, self.node_param.get_mut(v)) {
-                            *param = None;
-                        }
+                if let Some((dim, tag)) = *on
+                    && let Some(&(pd, pt)) = parents.get(&(dim, tag))
+                {
+                    *on = Some((pd, pt));
+                    if let (true, Some(param)) = (pd != dim, self.node_param.get_mut(v)) {
+                        *param = None;
                     }
                 }
             }

@@ -61,7 +61,7 @@ impl Solver {
                     ));
                 }
             }
-            if self.children[b - self.n].len() % 2 == 0 {
+            if self.children[b - self.n].len().is_multiple_of(2) {
                 return Err(format!("blossom {b} has an even cycle"));
             }
             if self.dual[b] < 0 {
@@ -100,21 +100,22 @@ impl Solver {
                 continue;
             }
             let m = self.mate[v];
-            if m != NONE && (v as u32) < m {
-                if let Some(a) = self.common(v as u32, m, &depth) {
-                    let mut y = a;
-                    loop {
-                        inner[y as usize] += 1;
-                        y = self.parent[y as usize];
-                        if y == NONE {
-                            break;
-                        }
+            if m != NONE
+                && (v as u32) < m
+                && let Some(a) = self.common(v as u32, m, &depth)
+            {
+                let mut y = a;
+                loop {
+                    inner[y as usize] += 1;
+                    y = self.parent[y as usize];
+                    if y == NONE {
+                        break;
                     }
                 }
             }
         }
         for &b in &blossoms {
-            if size[b] % 2 == 0 || size[b] < 3 {
+            if size[b].is_multiple_of(2) || size[b] < 3 {
                 return Err(format!("blossom {b} has {} vertices", size[b]));
             }
             if self.dual[b] > 0 && inner[b] != (size[b] - 1) / 2 {
