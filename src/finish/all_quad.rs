@@ -155,7 +155,7 @@ pub(crate) fn split(
     })
 }
 
-/// Splits the model's line element on side `p`-`q` (if any) at the new node `m`, and
+/// Splits the model's line elements on side `p`-`q` (if any: every copy) at the new node `m`, and
 /// classifies `m` on the curve the side lies on, or on surface `surface` when it lies on none.
 /// `edge` says whether the side is one where a curve must lie: used by one element, or by
 /// elements of two surfaces or by three or more.
@@ -172,15 +172,19 @@ pub(crate) fn split_model_edge(
     surface: i32,
     edge: bool,
 ) {
-    let line = model
-        .elements
-        .iter()
-        .position(|e| e.dim == 1 && e.nodes.len() == 2 && (e.nodes == [p, q] || e.nodes == [q, p]));
-    let curve = match line {
-        Some(i) => Some(model.elements[i].entity),
+    // Every line element on the side: a file may give a segment more than once (Gmsh's MSH
+    // 2.2 writes a curve's lines once per physical group; two curves may share a segment).
+    let lines: Vec<usize> = (model.elements.iter().enumerate())
+        .filter(|(_, e)| e.dim == 1 && e.nodes.len() == 2)
+        .filter(|(_, e)| e.nodes == [p, q] || e.nodes == [q, p])
+        .map(|(i, _)| i)
+        .collect();
+    let curve = match lines.first() {
+        Some(&i) => Some(model.elements[i].entity),
         None => curve_of_side(model, [p, q], surface, edge),
     };
-    if let Some(i) = line {
+    // From the last, so that the insertions leave the earlier indices in place.
+    for &i in lines.iter().rev() {
         let [a, b] = [model.elements[i].nodes[0], model.elements[i].nodes[1]];
         model.elements[i].nodes = vec![a, m];
         let mut second = model.elements[i].clone();

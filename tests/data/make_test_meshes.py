@@ -230,7 +230,7 @@ gmsh.finalize()
 
 # Curves inside a surface, both sides of them on that surface (tests/it/model.rs): a square
 # with an embedded crack (a polyline), an embedded circle and an embedded point, named groups
-# for the plate, the crack, the circle and the outer boundary; and the shell of a cylinder,
+# for the plate, the crack, the circle, both ("monitor") and the outer boundary; and the shell of a cylinder,
 # whose side surface meets itself along its seam curve (no groups: Gmsh saves every element,
 # the seam's lines too). No quad may straddle those curves: their segments stay element sides.
 start("crack")
@@ -246,6 +246,8 @@ gmsh.model.mesh.embed(0, [tip], 2, plate)
 gmsh.model.addPhysicalGroup(2, [plate], name="plate")
 gmsh.model.addPhysicalGroup(1, crack, name="crack")
 gmsh.model.addPhysicalGroup(1, [circle], name="circle")
+# The crack and the circle in a second group too: MSH 2.2 then writes their lines twice.
+gmsh.model.addPhysicalGroup(1, crack + [circle], name="monitor")
 gmsh.model.addPhysicalGroup(1, [c for _, c in gmsh.model.getBoundary([(2, plate)])], name="boundary")
 gmsh.model.addPhysicalGroup(0, [tip], name="tip")
 mesh(0.07)
