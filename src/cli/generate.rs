@@ -109,6 +109,7 @@ struct IcosphereArgs {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    super::oom::phase(super::oom::Phase::Generate);
     let start = Instant::now();
     let json = args.json;
     let (mesh, what, output) = match args.shape {

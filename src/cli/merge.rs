@@ -24,6 +24,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    super::oom::phase(super::oom::Phase::Merge);
     let start = std::time::Instant::now();
     super::errors::check_results_dir(&args.out)?;
     let merged = merge(&args.dirs, &args.out)?;

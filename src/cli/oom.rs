@@ -20,6 +20,11 @@ pub enum Phase {
     Search,
     Optimum,
     Writing,
+    Sweep,
+    Replay,
+    Report,
+    Merge,
+    Generate,
 }
 
 impl Phase {
@@ -32,6 +37,11 @@ impl Phase {
             Phase::Search => "searching (the state's verdicts and trees)",
             Phase::Optimum => "computing the optimum",
             Phase::Writing => "writing the output",
+            Phase::Sweep => "running the sweep (its meshes, their optimum, the runs, the report)",
+            Phase::Replay => "replaying the run (its mesh, the search, the export)",
+            Phase::Report => "making the report (the records, statistics and figures)",
+            Phase::Merge => "merging the sweeps (their records)",
+            Phase::Generate => "generating the mesh",
         }
     }
 
@@ -44,6 +54,11 @@ impl Phase {
             Phase::Search,
             Phase::Optimum,
             Phase::Writing,
+            Phase::Sweep,
+            Phase::Replay,
+            Phase::Report,
+            Phase::Merge,
+            Phase::Generate,
         ]
         .get(v as usize)
         .copied()

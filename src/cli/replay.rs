@@ -120,6 +120,7 @@ fn spans(indices: impl Iterator<Item = u32>) -> String {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    super::oom::phase(super::oom::Phase::Replay);
     let which = parse_run(&args.run)?;
     super::check_mesh_output(args.out.output.as_deref())?;
     let results = Results::read(&args.dir)?;

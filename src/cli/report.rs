@@ -87,6 +87,7 @@ fn parse_picture(s: &str) -> Result<(String, Option<u32>), UsageError> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    super::oom::phase(super::oom::Phase::Report);
     let start = std::time::Instant::now();
     let zoom = args.zoom.as_deref().map(parse_zoom).transpose()?;
     let picture_configs = args

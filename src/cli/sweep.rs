@@ -216,6 +216,7 @@ fn parse_time_budget(s: &str) -> Result<TimeBudget, String> {
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    super::oom::phase(super::oom::Phase::Sweep);
     let start = std::time::Instant::now();
     let mut paper = SweepRequest::default();
     let suite_defaults = args.suite.as_deref().map(suite_request).transpose()?;

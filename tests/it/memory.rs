@@ -79,11 +79,29 @@ fn out_of_memory_is_an_error_not_an_abort() {
         dir.path(),
         &["grid", "--triangles", "400000", "-o", "grid.msh"],
     );
-    for cmd in [
-        &["info", "grid.msh"][..],
-        &["recombine", "grid.msh", "--algo", "greedy"],
+    for (cmd, doing) in [
+        (&["info", "grid.msh"][..], ""),
+        (&["recombine", "grid.msh", "--algo", "greedy"], ""),
+        (&["optimum", "grid.msh"], ""),
+        (
+            &[
+                "sweep", "--mesh", "grid.msh", "--algo", "greedy", "--out", "sw",
+            ],
+            "while running the sweep",
+        ),
+        (
+            &[
+                "generate",
+                "grid",
+                "--triangles",
+                "3000000",
+                "-o",
+                "big.msh",
+            ],
+            "while generating the mesh",
+        ),
     ] {
-        // About 90 MB resident for `info`, more for `recombine`: 60 MB cannot do.
+        // About 90 MB resident for `info`, more for the others: 60 MB cannot do.
         let out = limited(dir.path(), 60_000, cmd);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(5), "{cmd:?}: {} {err}", out.status);
@@ -91,9 +109,16 @@ fn out_of_memory_is_an_error_not_an_abort() {
             err.contains("error: out of memory while") && err.contains("could not allocate"),
             "{cmd:?}: {err}"
         );
-        assert!(
-            err.contains("triangles") || err.contains("reading"),
-            "{err}"
-        );
+        // What was being done: a mesh command names the mesh's size or the reading, the
+        // others their own phase (they said "while starting").
+        if doing.is_empty() {
+            assert!(
+                err.contains("triangles") || err.contains("reading"),
+                "{err}"
+            );
+        } else {
+            assert!(err.contains(doing), "{cmd:?}: {err}");
+        }
+        assert!(!err.contains("while starting"), "{cmd:?}: {err}");
     }
 }
