@@ -52,7 +52,8 @@ impl std::fmt::Display for Backend {
 
 /// Errors of the GPU path. [`GpuError::NoAdapter`] and [`GpuError::RequestDevice`] are the
 /// environment's (no driver); [`GpuError::Shader`] and [`GpuError::Device`] are bugs or
-/// device failures, [`GpuError::OutOfMemory`] the device's or the host's memory; [`GpuError::BadIndex`] and [`GpuError::TooLarge`] are the caller's input.
+/// device failures, [`GpuError::OutOfMemory`] the device's or the host's memory;
+/// [`GpuError::BadIndex`] and [`GpuError::TooLarge`] are the caller's input.
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
     /// No Vulkan adapter: install a GPU driver, or lavapipe (Debian: mesa-vulkan-drivers),

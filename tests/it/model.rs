@@ -789,7 +789,7 @@ gmsh.finalize()
 /// greedy, selective (under the rule and `--allow-invalid`), the finish, all-quad and the
 /// optimum; and the result conforms (element sides used once are exactly the boundary's
 /// lines: no hanging node where all-quad split a side on the circle). Before, selective
-/// h = 3 made 10 of the crack's segments quad diagonals, greedy 6, the optimum 10. The MSH
+/// h = 3 made 10 of the 23 crack and circle segments quad diagonals, greedy 6, the optimum 10. The MSH
 /// 2.2 file holds the crack's and the circle's lines twice (two physical groups): all-quad
 /// split only the first copy of a line on a side it split (3 or 4 lines across a node).
 #[test]
