@@ -10,7 +10,7 @@ pub mod finish;
 pub mod gpu;
 #[path = "mesh/mod.rs"]
 pub mod mesh;
-#[path = "output.rs"]
+#[path = "output/mod.rs"]
 pub mod output;
 #[path = "quality.rs"]
 pub mod quality;

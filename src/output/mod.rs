@@ -4,10 +4,13 @@
 //! The content goes to a temporary file created exclusively, under a random name, in the
 //! target's own directory (so nobody can plant a link at a predictable name and make the
 //! write land elsewhere), reaches the disk, and is renamed over the target. A failed write
-//! (a full disk, a kill) leaves the earlier file as it was and removes the temporary.
+//! (a full disk) leaves the earlier file as it was and removes the temporary. A temporary left
+//! by a killed process is removed by the next write of the same file ([`stale`]).
 
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+
+mod stale;
 
 /// Writes the bytes produced by `fill` to `path` atomically.
 ///
@@ -41,7 +44,8 @@ pub fn write_atomic(
     let name = target
         .file_name()
         .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
-    let prefix = format!(".{name}.");
+    stale::remove_stale(dir, &name);
+    let prefix = stale::prefix(&name);
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(".tmp");
     #[cfg(unix)]
