@@ -249,6 +249,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         PathBuf::from("results").join(name)
     });
     super::errors::check_results_dir(&out)?;
+    // Refused even where no method reads it (greedy alone), as `--horizons 0` is: it asks
+    // for no runs, which the sweep would not do.
+    if args.runs == Some(0) {
+        return Err(config_error(ConfigError::ZeroRuns).into());
+    }
     let config = SweepConfig::new(SweepRequest {
         meshes,
         algos: if args.algos.is_empty() {

@@ -68,6 +68,10 @@ fn exit_2_usage_error() {
     args.extend(["--algo", "selective", "--horizons", "1", "--runs", "0"]);
     // The last --algo wins: selective with zero runs.
     fails_with(tmp.path(), &args, 2, "--runs must be at least 1");
+    // Also when no method given reads it.
+    let mut args = sweep_args("a");
+    args.extend(["--algo", "greedy", "--runs", "0"]);
+    fails_with(tmp.path(), &args, 2, "--runs must be at least 1");
     let mut args = sweep_args("a");
     args.extend(["--threads", "0"]);
     fails_with(tmp.path(), &args, 2, "--threads must be at least 1");
