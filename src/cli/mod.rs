@@ -204,19 +204,35 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), UsageError> {
     if p.is_dir() || p.as_os_str().to_string_lossy().ends_with('/') {
         return bad("names a directory, not a file".into());
     }
-    // A FIFO, socket or device there is refused before the work, not after it.
-    if let Ok(meta) = std::fs::metadata(p)
-        && !meta.is_file()
-    {
-        return bad(format!(
-            "exists and is {}, not a regular file: refusing to replace it",
-            quadrecomb::internals::mesh::file_kind(&meta)
-        ));
+    // A FIFO, socket or device there is refused before the work, not after it; so is a
+    // path the system cannot look at (a loop of symbolic links).
+    match std::fs::metadata(p) {
+        Ok(meta) if !meta.is_file() => {
+            return bad(format!(
+                "exists and is {}, not a regular file: refusing to replace it",
+                quadrecomb::internals::mesh::file_kind(&meta)
+            ));
+        }
+        #[cfg(unix)]
+        Err(e) if e.raw_os_error() == Some(libc::ELOOP) => {
+            return bad(format!("cannot be written: {e}"));
+        }
+        _ => {}
     }
-    let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+    // Through a symbolic link that leads to no file, the file the link names is created
+    // (as the writer does): its directory is the one that must take it.
+    let target = quadrecomb::internals::output::resolve(p);
+    let via = if std::fs::symlink_metadata(p).is_ok_and(|m| m.is_symlink()) {
+        format!(" (the symbolic link leads to {})", target.display())
+    } else {
+        String::new()
+    };
+    let dir = target.parent().filter(|d| !d.as_os_str().is_empty());
     match dir {
-        Some(d) if d.exists() && !d.is_dir() => bad(format!("{} is not a directory", d.display())),
-        Some(d) if !d.exists() => bad(format!("directory {} does not exist", d.display())),
+        Some(d) if d.exists() && !d.is_dir() => {
+            bad(format!("{} is not a directory{via}", d.display()))
+        }
+        Some(d) if !d.exists() => bad(format!("directory {} does not exist{via}", d.display())),
         _ => {
             let d = dir.unwrap_or(std::path::Path::new("."));
             match tempfile::Builder::new()
@@ -225,7 +241,7 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), UsageError> {
             {
                 Ok(_) => Ok(()),
                 Err(e) => bad(format!(
-                    "directory {} does not take a new file ({e}); choose another -o",
+                    "directory {} does not take a new file ({e}){via}; choose another -o",
                     d.display()
                 )),
             }

@@ -14,7 +14,8 @@ mod stale;
 
 /// Writes the bytes produced by `fill` to `path` atomically.
 ///
-/// A symbolic link at `path` is followed: the file it points to is replaced, not the link.
+/// A symbolic link at `path` is followed: the file it points to is replaced (or created, when
+/// the link dangles), not the link.
 /// An existing file keeps its permissions; a new one gets the usual `0666 & !umask`. An
 /// existing directory, FIFO, socket or device at `path` is refused (replacing a device node
 /// with a regular file is never what was meant). Errors do not name `path`: callers add it.
@@ -73,10 +74,26 @@ pub fn write_bytes(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomic(path, |w| w.write_all(bytes))
 }
 
-/// The file a path names once its symbolic links are followed; the path itself when it does
-/// not exist yet (or its link dangles: the link is then replaced).
-fn resolve(path: &Path) -> PathBuf {
-    std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
+/// The file a path names once its symbolic links are followed: for a path that does not
+/// exist yet, the path itself, or, for a link that leads to no file (yet), the file it would
+/// create, as a shell's `>` does (its directory may not exist: creating the temporary then
+/// fails). A loop of links ends after 40 steps, on a link: creating beside it fails or
+/// replaces it.
+pub fn resolve(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let mut p = path.to_path_buf();
+    for _ in 0..40 {
+        let Ok(target) = std::fs::read_link(&p) else {
+            break;
+        };
+        p = match p.parent() {
+            Some(dir) if target.is_relative() => dir.join(target),
+            _ => target,
+        };
+    }
+    p
 }
 
 #[cfg(test)]
