@@ -11,6 +11,10 @@
 //!   quads that were in the input (no eta is computed for them);
 //! - `surface` (Int32): the geometric entity (surface) tag;
 //! - `kind` (UInt8): `0` recombined quad, `1` leftover triangle, `2` input quad.
+//!
+//! and one point-data array, `node` (UInt64): each point's node tag in the input file. The
+//! points are every node of the input in the loaded mesh's order (spatial, not the file's:
+//! [`super::order`]), so `node` is what maps them back to the input.
 
 use super::{Mesh, ReadError, Recombined};
 use std::io::{self, Write};
@@ -52,6 +56,7 @@ pub fn write(path: &Path, mesh: &Mesh, rec: &Recombined) -> Result<(), ReadError
 enum Values {
     F64(Vec<f64>),
     I64(Vec<i64>),
+    U64(Vec<u64>),
     I32(Vec<i32>),
     U8(Vec<u8>),
 }
@@ -61,6 +66,7 @@ impl Values {
         match self {
             Values::F64(_) => "Float64",
             Values::I64(_) => "Int64",
+            Values::U64(_) => "UInt64",
             Values::I32(_) => "Int32",
             Values::U8(_) => "UInt8",
         }
@@ -83,6 +89,7 @@ impl Values {
         match self {
             Values::F64(v) => lines(w, v, per_line, |x| format!("{x:?}")),
             Values::I64(v) => lines(w, v, per_line, i64::to_string),
+            Values::U64(v) => lines(w, v, per_line, u64::to_string),
             Values::I32(v) => lines(w, v, per_line, i32::to_string),
             Values::U8(v) => lines(w, v, per_line, u8::to_string),
         }
@@ -93,6 +100,7 @@ impl Values {
         match self {
             Values::F64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
             Values::I64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            Values::U64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
             Values::I32(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
             Values::U8(v) => v.clone(),
         }
@@ -167,6 +175,7 @@ pub fn write_to(
         Values::F64(mesh.vertices.iter().flatten().copied().collect()),
         3,
     );
+    let node = array("node", 1, Values::U64(mesh.vertex_ids.clone()), 1);
     let mut offsets = Vec::with_capacity(cells.len());
     let mut off = 0;
     for (c, ..) in &cells {
@@ -222,6 +231,7 @@ pub fn write_to(
     let all: Vec<&Array> = std::iter::once(&points)
         .chain(&cell_arrays)
         .chain(&cell_data)
+        .chain(std::iter::once(&node))
         .collect();
     // Binary: each array's compressed block, and its offset in the appended data.
     let blocks: Vec<Vec<u8>> = match encoding {
@@ -286,7 +296,10 @@ pub fn write_to(
     for a in &cell_data {
         element(w, a)?;
     }
-    writeln!(w, "</CellData>\n</Piece>\n</UnstructuredGrid>")?;
+    writeln!(w, "</CellData>")?;
+    writeln!(w, "<PointData>")?;
+    element(w, &node)?;
+    writeln!(w, "</PointData>\n</Piece>\n</UnstructuredGrid>")?;
     if encoding == Encoding::Binary {
         // The data start after the underscore; meshio drops the line break before the
         // closing tag, VTK reads by the offsets.

@@ -355,6 +355,10 @@ fn vtu_ascii_is_well_formed_with_cell_data() {
     let kind = data_array(&xml, "kind");
     assert_eq!(quality.len(), cells);
     assert_eq!(data_array(&xml, "surface").len(), cells);
+    let node: Vec<u64> = (data_array(&xml, "node").iter())
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(node, m.vertex_ids);
     for (q, k) in quality.iter().zip(&kind) {
         match *k {
             "0" => assert!((0.0..=1.0).contains(q)),
@@ -382,7 +386,10 @@ fn vtu_ascii_is_well_formed_with_cell_data() {
 /// in less than a third of the bytes.
 #[test]
 fn vtu_binary_reads_in_vtk_and_meshio() {
-    if !python_module_available("vtk") || !python_module_available("meshio") {
+    if !["vtk", "meshio", "gmsh"]
+        .iter()
+        .all(|m| python_module_available(m))
+    {
         return;
     }
     let m = mesh::load("borouchaki").unwrap();
@@ -419,6 +426,7 @@ def by_vtk(path):
         "quality": vtk_to_numpy(cd.GetArray("quality")),
         "surface": vtk_to_numpy(cd.GetArray("surface")),
         "kind": vtk_to_numpy(cd.GetArray("kind")),
+        "node": vtk_to_numpy(g.GetPointData().GetArray("node")),
     }
 b, a = by_vtk(sys.argv[1]), by_vtk(sys.argv[2])
 for k in b:
@@ -431,6 +439,18 @@ for cb, ca in zip(mb.cells, ma.cells):
 for name in ("quality", "surface", "kind"):
     for x, y in zip(mb.cell_data[name], ma.cell_data[name]):
         assert np.array_equal(x, y), name
+assert np.array_equal(mb.point_data["node"], b["node"])
+# Each point is the input's node that `node` names, as Gmsh reads the input.
+import gmsh
+gmsh.initialize(["-noenv"])
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.open(sys.argv[3])
+tags, xyz, _ = gmsh.model.mesh.getNodes()
+gmsh.finalize()
+at = dict(zip(tags.tolist(), xyz.reshape(-1, 3).tolist()))
+assert b["node"].dtype == np.uint64, b["node"].dtype
+assert sorted(b["node"].tolist()) == sorted(at), "node tags"
+assert all(at[int(t)] == p.tolist() for t, p in zip(b["node"], b["points"])), "node coordinates"
 print(json.dumps({
     "points": int(b["points"].shape[0]),
     "quads": int((b["types"] == 9).sum()),
@@ -440,7 +460,9 @@ print(json.dumps({
     "meshio": {c.type: int(len(c.data)) for c in mb.cells},
 }))
 "#;
-    let r: serde_json::Value = serde_json::from_str(&python(script, &[&bin, &ascii])).unwrap();
+    let input = crate::util::repo_path("meshes/borouchaki.msh");
+    let r: serde_json::Value =
+        serde_json::from_str(&python(script, &[&bin, &ascii, &input])).unwrap();
     assert_eq!(r["points"], m.vertices.len());
     assert_eq!(r["quads"], rec.quads.len() + m.quads.len());
     assert_eq!(r["triangles"], rec.leftover.len());
