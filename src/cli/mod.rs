@@ -227,6 +227,9 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), UsageError> {
     } else {
         String::new()
     };
+    if target.as_os_str().to_string_lossy().ends_with('/') {
+        return bad(format!("names a directory, not a file{via}"));
+    }
     let dir = target.parent().filter(|d| !d.as_os_str().is_empty());
     match dir {
         Some(d) if d.exists() && !d.is_dir() => {

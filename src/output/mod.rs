@@ -44,9 +44,9 @@ pub fn write_atomic(
     };
     let name = target
         .file_name()
-        .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
-    stale::remove_stale(dir, &name);
-    let prefix = stale::prefix(&name);
+        .unwrap_or_else(|| std::ffi::OsStr::new("output"));
+    stale::remove_stale(dir, name);
+    let prefix = stale::prefix(name);
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(".tmp");
     #[cfg(unix)]

@@ -1192,6 +1192,40 @@ fn results_paths_that_cannot_work_are_refused_before_any_run() {
             stderr(&out)
         );
     }
+    // A file the sweep writes that is a link where no file can be made (its directory
+    // missing, a loop): refused before the runs (the write goes through the link, so it
+    // failed after every run). A dangling link into a directory that exists is written
+    // through: the file it names is created.
+    for (name, to) in [
+        ("summary.csv", "../elsewhere/summary.csv"),
+        ("report.md", "report.md"),
+    ] {
+        let d = dir.join(format!("l-{name}"));
+        std::fs::create_dir(&d).unwrap();
+        std::os::unix::fs::symlink(to, d.join(name)).unwrap();
+        let out = run_in(dir, &small_sweep_args(&format!("l-{name}")));
+        assert_eq!(out.status.code(), Some(4), "{name}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains(&format!("{name} is a symbolic link to ")),
+            "{}",
+            stderr(&out)
+        );
+        assert!(!d.join("runs.jsonl").exists());
+    }
+    std::fs::create_dir_all(dir.join("ok/kept")).unwrap();
+    std::os::unix::fs::symlink("kept/summary.csv", dir.join("ok/summary.csv")).unwrap();
+    let out = run_in(dir, &small_sweep_args("ok"));
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        std::fs::symlink_metadata(dir.join("ok/summary.csv"))
+            .unwrap()
+            .is_symlink()
+    );
+    assert!(
+        std::fs::read_to_string(dir.join("ok/kept/summary.csv"))
+            .unwrap()
+            .starts_with("mesh,")
+    );
     // A file named `figures` where the report writes its figures: refused before the runs
     // (the sweep ran every run, then failed writing the report).
     std::fs::create_dir(dir.join("f")).unwrap();
