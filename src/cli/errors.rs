@@ -65,41 +65,30 @@ pub fn check_results_dir(dir: &std::path::Path) -> anyhow::Result<()> {
     // A file the sweep writes that is a symbolic link to a place where no file can be made
     // (its directory missing, a loop): the write goes through the link, so it would fail
     // after every run.
-    {
-        use quadrecomb::internals::experiment::{engine, manifest, store, summary};
-        for name in [
-            store::RUNS_FILE,
-            manifest::MANIFEST_FILE,
-            summary::SUMMARY_CSV,
-            summary::SUMMARY_JSON,
-            engine::ACROSS_CSV,
-            engine::REPORT_FILES,
-            "report.md",
-            "report.html",
-        ] {
-            let path = dir.join(name);
-            let is_link =
-                std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_symlink());
-            if !is_link || std::fs::metadata(&path).is_ok() {
-                continue;
-            }
-            let target = quadrecomb::internals::output::resolve(&path);
-            let parent = target.parent().filter(|p| !p.as_os_str().is_empty());
-            if parent.is_none_or(|p| p.is_dir()) && !target.as_os_str().is_empty() {
-                let loops = std::fs::symlink_metadata(&target).is_ok_and(|m| m.is_symlink());
-                if !loops {
-                    continue;
-                }
-            }
-            return Err(UnusableResultsDir(format!(
-                "--out {}: {} is a symbolic link to {}, where no file can be made; fix or \
-                 remove the link",
-                dir.display(),
-                path.display(),
-                target.display()
-            ))
-            .into());
+    for name in quadrecomb::internals::experiment::engine::SWEEP_FILES {
+        let path = dir.join(name);
+        let is_link = std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_symlink());
+        if !is_link || std::fs::metadata(&path).is_ok() {
+            continue;
         }
+        // Dangling: fine when the file it names can be made (resolve ends on a link only
+        // in a loop).
+        let target = quadrecomb::internals::output::resolve(&path);
+        let dir_ok = target
+            .parent()
+            .is_none_or(|p| p.as_os_str().is_empty() || p.is_dir());
+        let loops = std::fs::symlink_metadata(&target).is_ok_and(|m| m.is_symlink());
+        if dir_ok && !loops {
+            continue;
+        }
+        return Err(UnusableResultsDir(format!(
+            "--out {}: {} is a symbolic link to {}, where no file can be made; fix or remove \
+             the link",
+            dir.display(),
+            path.display(),
+            target.display()
+        ))
+        .into());
     }
     // The report's figures go in DIR/figures: a file there would stop it after every run.
     let figures = dir.join("figures");

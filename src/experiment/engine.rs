@@ -394,19 +394,7 @@ fn clear_results(dir: &Path) -> Result<(), ExperimentError> {
     // Refuses a manifest that is not a sweep's (before deleting anything).
     Manifest::read(dir)?;
     let mut names: Vec<PathBuf> = report_files(dir)?.into_iter().map(PathBuf::from).collect();
-    names.extend(
-        [
-            REPORT_FILES,
-            RUNS_FILE,
-            MANIFEST_FILE,
-            summary::SUMMARY_CSV,
-            summary::SUMMARY_JSON,
-            ACROSS_CSV,
-            "report.md",
-            "report.html",
-        ]
-        .map(PathBuf::from),
-    );
+    names.extend(SWEEP_FILES.map(PathBuf::from));
     for name in names {
         let path = dir.join(name);
         match std::fs::remove_file(&path) {
@@ -454,6 +442,18 @@ pub(super) fn refuse_foreign_files(dir: &Path) -> Result<(), ExperimentError> {
         })
     }
 }
+
+/// The files a sweep and its report write in a results directory, besides the figures.
+pub const SWEEP_FILES: [&str; 8] = [
+    REPORT_FILES,
+    RUNS_FILE,
+    MANIFEST_FILE,
+    summary::SUMMARY_CSV,
+    summary::SUMMARY_JSON,
+    ACROSS_CSV,
+    "report.md",
+    "report.html",
+];
 
 /// File in a results directory listing the figures its report wrote, one relative path a
 /// line, so that `--overwrite` and the next report remove those and no other file.
