@@ -5,7 +5,7 @@
 //! target's own directory (so nobody can plant a link at a predictable name and make the
 //! write land elsewhere), reaches the disk, and is renamed over the target. A failed write
 //! (a full disk) leaves the earlier file as it was and removes the temporary. A temporary left
-//! by a killed process is removed by the next write of the same file ([`stale`]).
+//! by a killed process is removed by the next write of the same file (module `stale`).
 
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
