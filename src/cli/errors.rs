@@ -67,28 +67,16 @@ pub fn check_results_dir(dir: &std::path::Path) -> anyhow::Result<()> {
     // after every run.
     for name in quadrecomb::internals::experiment::engine::SWEEP_FILES {
         let path = dir.join(name);
-        let is_link = std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_symlink());
-        if !is_link || std::fs::metadata(&path).is_ok() {
-            continue;
+        if let Some(target) = quadrecomb::internals::output::dead_end_link(&path) {
+            return Err(UnusableResultsDir(format!(
+                "--out {}: {} is a symbolic link to {}, where no file can be made; fix or \
+                 remove the link",
+                dir.display(),
+                path.display(),
+                target.display()
+            ))
+            .into());
         }
-        // Dangling: fine when the file it names can be made (resolve ends on a link only
-        // in a loop).
-        let target = quadrecomb::internals::output::resolve(&path);
-        let dir_ok = target
-            .parent()
-            .is_none_or(|p| p.as_os_str().is_empty() || p.is_dir());
-        let loops = std::fs::symlink_metadata(&target).is_ok_and(|m| m.is_symlink());
-        if dir_ok && !loops {
-            continue;
-        }
-        return Err(UnusableResultsDir(format!(
-            "--out {}: {} is a symbolic link to {}, where no file can be made; fix or remove \
-             the link",
-            dir.display(),
-            path.display(),
-            target.display()
-        ))
-        .into());
     }
     // The report's figures go in DIR/figures: a file there would stop it after every run.
     let figures = dir.join("figures");

@@ -96,6 +96,25 @@ pub fn resolve(path: &Path) -> PathBuf {
     p
 }
 
+/// For a symbolic link at `path` that leads to a place where no file can be made (its
+/// directory missing, or a loop of links), the place it leads to; `None` for anything else,
+/// a link to an existing file or to a file that can be created included. A write through
+/// such a link fails, so commands check their outputs with this before the work.
+pub fn dead_end_link(path: &Path) -> Option<PathBuf> {
+    let is_link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if !is_link || std::fs::metadata(path).is_ok() {
+        return None;
+    }
+    // Dangling: fine when the file it names can be made (resolve ends on a link only in a
+    // loop).
+    let target = resolve(path);
+    let dir_ok = target
+        .parent()
+        .is_none_or(|p| p.as_os_str().is_empty() || p.is_dir());
+    let loops = std::fs::symlink_metadata(&target).is_ok_and(|m| m.is_symlink());
+    (!dir_ok || loops).then_some(target)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -140,6 +140,27 @@ pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportErro
             ),
         });
     }
+    // A file the report writes that is a symbolic link to where no file can be made: the
+    // write through it would fail after the pictures' runs.
+    let reads = [
+        crate::experiment::store::RUNS_FILE,
+        crate::experiment::manifest::MANIFEST_FILE,
+    ];
+    for name in crate::experiment::engine::SWEEP_FILES
+        .iter()
+        .filter(|n| !reads.contains(n))
+    {
+        if let Some(target) = crate::output::dead_end_link(&dir.join(name)) {
+            return Err(ReportError::NotResults {
+                dir: dir.to_path_buf(),
+                why: format!(
+                    "{name} is a symbolic link to {}, where no file can be made: fix or remove \
+                     the link",
+                    target.display()
+                ),
+            });
+        }
+    }
     // The summary follows the runs it is made of (it was left stale after an edit).
     let summary = crate::experiment::summary::write(dir, &results.runs())?;
     let other = match &opts.compare {

@@ -1236,6 +1236,20 @@ fn results_paths_that_cannot_work_are_refused_before_any_run() {
     // `report` on a results directory with one: exit 3 naming it, nothing written.
     let out = run_in(dir, &small_sweep_args("s"));
     assert!(out.status.success(), "{}", stderr(&out));
+    // `report` with a file it writes linked into a missing directory: exit 3 naming the
+    // link, before anything is written (it failed after the pictures' runs).
+    std::fs::remove_file(dir.join("s/report.html")).unwrap();
+    std::fs::remove_file(dir.join("s/report.md")).unwrap();
+    std::os::unix::fs::symlink("../gone/report.html", dir.join("s/report.html")).unwrap();
+    let out = run_in(dir, &["report", "s"]);
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("report.html is a symbolic link to s/../gone/report.html"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!dir.join("s/report.md").exists());
+    std::fs::remove_file(dir.join("s/report.html")).unwrap();
     std::fs::remove_dir_all(dir.join("s/figures")).ok();
     std::fs::write(dir.join("s/figures"), "mine").unwrap();
     let out = run_in(dir, &["report", "s"]);

@@ -239,11 +239,19 @@ impl Algo {
     }
 
     /// The uniform tree of horizon `h` (at least 1).
+    ///
+    /// # Panics
+    ///
+    /// If `h` is 0; [`Algo::from_name`]`("uniform", h)` returns the error instead.
     pub fn uniform(h: u32) -> Algo {
         Algo::from_name("uniform", h).expect("a horizon of at least 1")
     }
 
     /// The selective tree of horizon `h` (at least 1).
+    ///
+    /// # Panics
+    ///
+    /// If `h` is 0; [`Algo::from_name`]`("selective", h)` returns the error instead.
     pub fn selective(h: u32) -> Algo {
         Algo::from_name("selective", h).expect("a horizon of at least 1")
     }
