@@ -676,6 +676,33 @@ fn skipped_elements_on_missing_nodes_are_refused() {
     }
 }
 
+/// A node tag 0 is refused in every node reader, named where it is (tags are positive; Gmsh
+/// reads such a file but gives node 0 the tag of another node, so our output of it would not
+/// be what Gmsh then reads).
+#[test]
+fn node_tag_zero_is_refused() {
+    let v22 = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n0 1 0 0\n3 0 1 0\n\
+               $EndNodes\n$Elements\n1\n1 2 2 1 1 1 0 3\n$EndElements\n";
+    let v41 = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 3 0 3\n2 1 0 3\n1\n0\n3\n0 0 0\n\
+               1 0 0\n0 1 0\n$EndNodes\n$Elements\n1 1 1 1\n2 1 2 1\n1 1 0 3\n$EndElements\n";
+    let mut b41 = msh41_binary_tet(3);
+    // The binary file's node tags 1, 2, 3 (one block) become 1, 0, 3.
+    let tags: Vec<u8> = [1u64, 2, 3].iter().flat_map(|t| t.to_le_bytes()).collect();
+    let at = b41.windows(24).position(|w| w == tags).unwrap();
+    b41[at + 8..at + 16].copy_from_slice(&0u64.to_le_bytes());
+    for (name, bytes, at) in [
+        ("a22.msh", v22.as_bytes().to_vec(), "a22.msh:7:"),
+        ("a41.msh", v41.as_bytes().to_vec(), "a41.msh:8:"),
+        ("b41.msh", b41, "byte offset "),
+    ] {
+        let msg = msh::read_bytes(name, &bytes).unwrap_err().to_string();
+        assert!(
+            msg.contains(at) && msg.contains("bad node tag 0 (tags are positive)"),
+            "{name}: {msg}"
+        );
+    }
+}
+
 /// MSH 2.2 binary: nodes 1..3 and one triangle (element 1), then a tetrahedron (element 2)
 /// on nodes 1, 2, 3 and `node`.
 fn msh22_binary_tet(node: u64) -> Vec<u8> {

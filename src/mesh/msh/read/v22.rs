@@ -18,6 +18,9 @@ pub(super) fn nodes22_ascii(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     c.data.vertices.reserve(cap(total, 8, left));
     for i in 0..total {
         let tag = p.uint(s, &|| format!("the tag of node {} of {total}", i + 1))?;
+        if tag == 0 {
+            return Err(p.err(p.pos, "bad node tag 0 (tags are positive)"));
+        }
         let what = || format!("a coordinate of node {tag}");
         p.entry_start();
         let (at, x) = p.float(s, &what)?;

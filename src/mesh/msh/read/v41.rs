@@ -263,6 +263,9 @@ fn node_block41_ascii(p: &mut Parser<'_>, c: &mut Content, b: &NodeBlock41) -> R
     let (blk, n, extra) = (b.index, b.len, b.extra);
     for i in 0..n {
         let tag = p.uint(s, &|| format!("node tag {} of block {}", i + 1, blk + 1))?;
+        if tag == 0 {
+            return Err(p.err(p.pos, "bad node tag 0 (tags are positive)"));
+        }
         p.entry_start();
         p.entry_end(&|| format!("node tag {tag}"))?;
         c.node_tags.push(tag);
@@ -297,6 +300,9 @@ fn node_block41_binary(p: &mut Parser<'_>, c: &mut Content, b: &NodeBlock41) -> 
     let what_tags = || format!("the node tags of block {}", blk + 1);
     let tp = p.pos;
     let tags = p.take_array(n, 8, s, &what_tags)?;
+    if let Some(i) = tags.chunks_exact(8).position(|t| u64_at(t, 0) == 0) {
+        return Err(p.err_bin(tp + 8 * i, "bad node tag 0 (tags are positive)"));
+    }
     c.node_tags
         .extend(tags.chunks_exact(8).map(|t| u64_at(t, 0)));
     if c.tag_pos.is_some() {
