@@ -263,3 +263,18 @@ gmsh.model.removeEntities(gmsh.model.getEntities(3))
 mesh(0.15)
 write("cylinder_41_ascii.msh", 4.1, 0)
 gmsh.finalize()
+
+# A mesh written one file per partition with ghost cells (PartitionSplitMeshFiles): each
+# file's ghost surface holds copies of the neighbouring partition's triangles, which the
+# reader skips, so the two files' triangles are the whole mesh's, each once. The whole mesh
+# is written first, for comparison.
+start("split")
+gmsh.model.occ.addRectangle(0, 0, 0, 1, 1)
+mesh(0.3)
+gmsh.model.addPhysicalGroup(2, [1], name="S")
+write("split_whole_41_ascii.msh", 4.1, 0)
+gmsh.option.setNumber("Mesh.PartitionCreateGhostCells", 1)
+gmsh.option.setNumber("Mesh.PartitionSplitMeshFiles", 1)
+gmsh.model.mesh.partition(2)
+write("split_41_ascii.msh", 4.1, 0)
+gmsh.finalize()

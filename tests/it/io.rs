@@ -1697,6 +1697,35 @@ fn partitioned_meshes_keep_their_model_surfaces() {
     }
 }
 
+/// A mesh written one file per partition with ghost cells: each file's ghost surface (in the
+/// header of `$PartitionedEntities`) holds copies of the other partition's triangles. They
+/// are skipped and counted as ghost cells (they were recombined onto a surface of their own),
+/// so the two files' triangles are the whole mesh's, each once.
+#[test]
+fn ghost_cells_of_split_partition_files_are_skipped() {
+    let whole = read("split_whole_41_ascii.msh");
+    let mut union = BTreeSet::new();
+    for name in ["split_41_ascii_1.msh", "split_41_ascii_2.msh"] {
+        let file = msh::parse(&data(name), &std::fs::read(data(name)).unwrap()).unwrap();
+        let ghosts: Vec<&msh::SkippedElements> =
+            file.skipped.iter().filter(|k| k.ghost_cells).collect();
+        assert!(
+            ghosts.len() == 1 && ghosts[0].gmsh_type == 2 && ghosts[0].count > 0,
+            "{name}: {ghosts:?}"
+        );
+        assert!(ghosts[0].to_string().ends_with("(ghost cells)"), "{name}");
+        let m = file.into_mesh(&data(name)).unwrap();
+        assert_eq!(m.surfaces(), vec![1], "{name}");
+        let own = triangle_points_set(&m);
+        assert!(
+            own.is_disjoint(&union),
+            "{name}: a triangle is in both files"
+        );
+        union.extend(own);
+    }
+    assert_eq!(union, triangle_points_set(&whole));
+}
+
 /// A partitioned 3D mesh in MSH 4.1 has, besides the partitions of the box's faces, partition
 /// surfaces cut from the volume: the interface between the two partitions, with triangles
 /// inside the box (they made a non-manifold error). They are skipped and counted apart; the

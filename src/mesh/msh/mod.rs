@@ -77,6 +77,10 @@ pub struct SkippedElements {
     /// 3D mesh (MSH 4.1 partition surfaces whose parent is a volume): triangles inside the
     /// volume, skipped whatever their type.
     pub on_partition_interfaces: bool,
+    /// True for ghost cells: elements on a ghost entity of a partitioned mesh written one
+    /// file per partition (copies of the neighbouring partitions' elements), skipped
+    /// whatever their type.
+    pub ghost_cells: bool,
 }
 
 impl SkippedElements {
@@ -93,6 +97,9 @@ impl fmt::Display for SkippedElements {
         write!(f, "{} {} (type {})", self.count, self.name, self.gmsh_type)?;
         if self.on_partition_interfaces {
             f.write_str(" on partition interfaces")?;
+        }
+        if self.ghost_cells {
+            f.write_str(" (ghost cells)")?;
         }
         Ok(())
     }

@@ -63,6 +63,18 @@ impl NodeMap {
     }
 }
 
+/// Where skipped elements were, when that is why they were skipped whatever their type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub(super) enum Apart {
+    /// On a model entity (skipped for their type).
+    No,
+    /// On an interface between volume partitions (a surface inside a volume; see
+    /// `Content::interfaces`).
+    Interface,
+    /// On a ghost entity (see `Content::ghosts`).
+    Ghost,
+}
+
 /// The content of a MSH file, before validation.
 pub(super) struct Content {
     pub(super) data: MeshData,
@@ -70,15 +82,18 @@ pub(super) struct Content {
     /// Where each node tag is (offsets), noted only when a duplicate tag is looked for.
     pub(super) tag_pos: Option<Vec<usize>>,
     pub(super) map: Option<NodeMap>,
-    /// Skipped elements: count per Gmsh type and whether they were on a partition
-    /// interface (a surface inside a volume; see `interfaces`).
-    pub(super) skipped: BTreeMap<(i64, bool), usize>,
+    /// Skipped elements: count per Gmsh type and where they were.
+    pub(super) skipped: BTreeMap<(i64, Apart), usize>,
     /// Partitioned files (4.1): the parent surface of each partition's surface entity.
     pub(super) parents: HashMap<i64, i32>,
     /// Partitioned 3D meshes (4.1): partition surfaces whose parent is a volume, the
     /// interfaces between volume partitions. Their triangles lie inside the volume, not on
     /// a model surface, and are skipped.
     pub(super) interfaces: HashSet<i64>,
+    /// Partitioned files (4.1): the ghost entities of the header of `$PartitionedEntities`
+    /// (copies of the elements of other partitions next to this one, in a file per
+    /// partition).
+    pub(super) ghosts: HashSet<i64>,
     /// MSH 4.1: the entities of the `$Nodes` blocks (Gmsh makes an entity a block names if
     /// `$Entities` does not declare it; an element block's entity must be declared one way).
     pub(super) node_block_entities: HashSet<(u8, i32)>,
@@ -233,6 +248,7 @@ impl Content {
             skipped: BTreeMap::new(),
             parents: HashMap::new(),
             interfaces: HashSet::new(),
+            ghosts: HashSet::new(),
             node_block_entities: HashSet::new(),
             model: ModelParts::default(),
         }
@@ -247,8 +263,8 @@ impl Content {
     }
 
     /// Counts `n` skipped elements of type `etype` (on a partition interface or not).
-    pub(super) fn skip(&mut self, etype: i64, n: u64, on_interface: bool) {
-        *self.skipped.entry((etype, on_interface)).or_default() += n as usize;
+    pub(super) fn skip(&mut self, etype: i64, n: u64, apart: Apart) {
+        *self.skipped.entry((etype, apart)).or_default() += n as usize;
     }
 }
 

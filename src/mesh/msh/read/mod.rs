@@ -21,7 +21,7 @@ mod v41;
 use super::{MshFile, MshVersion, SkippedElements};
 use crate::mesh::ReadError;
 use crate::mesh::msh::model::PhysicalName;
-use content::{Content, NodeMap};
+use content::{Apart, Content, NodeMap};
 use parser::{Parser, Res, show, to_i32};
 use std::path::Path;
 use v22::{elements22_ascii, elements22_binary, nodes22_ascii, nodes22_binary, parametric_nodes22};
@@ -233,14 +233,15 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
         skipped: c
             .skipped
             .into_iter()
-            .map(|((t, on_interface), n)| {
+            .map(|((t, apart), n)| {
                 let (_, dim, name) = element_type(t).expect("skipped types are known");
                 SkippedElements {
                     gmsh_type: t,
                     name,
                     dim,
                     count: n,
-                    on_partition_interfaces: on_interface,
+                    on_partition_interfaces: apart == Apart::Interface,
+                    ghost_cells: apart == Apart::Ghost,
                 }
             })
             .collect(),

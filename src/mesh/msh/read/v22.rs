@@ -2,7 +2,7 @@
 //! `$ParametricNodes` and `$Elements` (one element per record, its tags before its nodes).
 
 use super::content::{
-    Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
+    Apart, Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
 };
 use super::element_types::{
     MAX_LOWER_NODES, QUAD, TRIANGLE, element_nodes, element_type, is_lower, unknown_type,
@@ -158,7 +158,7 @@ pub(super) fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMa
         let keep = etype == TRIANGLE || etype == QUAD;
         let lower = is_lower(dim, nn);
         if !keep {
-            c.skip(etype, 1, false);
+            c.skip(etype, 1, Apart::No);
         }
         if nn == 0 {
             p.skip_line();
@@ -258,7 +258,7 @@ pub(super) fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeM
             check_block_nodes(p, map, data, at0, stride, nn, tag, node, key)?;
         }
         if !keep {
-            c.skip(etype, n as u64, false);
+            c.skip(etype, n as u64, Apart::No);
         }
         seen += n as u64;
     }

@@ -3,7 +3,7 @@
 //! type).
 
 use super::content::{
-    Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
+    Apart, Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
 };
 use super::element_types::{
     MAX_LOWER_NODES, QUAD, TRIANGLE, element_nodes, element_type, is_lower, unknown_type,
@@ -23,8 +23,9 @@ pub(super) fn partitioned41(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     p.size_t(s, &|| "the number of partitions".into())?;
     let ghosts = p.size_t(s, &|| "the number of ghost entities".into())?;
     for _ in 0..ghosts {
-        p.int_field(s, &|| "a ghost entity tag".into())?;
+        let tag = p.int_field(s, &|| "a ghost entity tag".into())?;
         p.int_field(s, &|| "a ghost entity's partition".into())?;
+        c.ghosts.insert(tag);
     }
     let counts: Vec<u64> = ["points", "curves", "surfaces", "volumes"]
         .iter()
@@ -378,7 +379,13 @@ pub(super) fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> 
             dim,
             nodes,
             surface,
-            on_interface: entity_dim == 2 && c.interfaces.contains(&entity),
+            apart: match entity_dim {
+                2 if c.interfaces.contains(&entity) => Apart::Interface,
+                // A ghost entity is of the mesh's dimension; a surface of that tag that
+                // `$PartitionedEntities` declares is a partition's own.
+                2 if c.ghosts.contains(&entity) && !c.parents.contains_key(&entity) => Apart::Ghost,
+                _ => Apart::No,
+            },
         };
         if block.keep() || block.lower() {
             // With `$Entities`, the entity must be declared there, in `$PartitionedEntities`
@@ -436,14 +443,14 @@ struct Block41 {
     nodes: usize,
     /// The entity the elements are on.
     surface: i32,
-    /// On a partition interface (skipped whatever its type).
-    on_interface: bool,
+    /// Whether the block is on a partition interface or a ghost entity (then skipped).
+    apart: Apart,
 }
 
 impl Block41 {
     /// Whether the block's elements are read: triangles and quads not on an interface.
     fn keep(&self) -> bool {
-        (self.etype == TRIANGLE || self.etype == QUAD) && !self.on_interface
+        (self.etype == TRIANGLE || self.etype == QUAD) && self.apart == Apart::No
     }
 
     /// Whether the block's elements go to the model: points and lines.
@@ -501,7 +508,7 @@ fn element_block41_ascii(
         }
     }
     if !keep {
-        c.skip(b.etype, b.len, b.on_interface);
+        c.skip(b.etype, b.len, b.apart);
     }
     Ok(())
 }
@@ -541,7 +548,7 @@ fn element_block41_binary(
         check_block_nodes(p, map, data, at0, stride, nn, tag, node, |v| v)?;
     }
     if !b.keep() {
-        c.skip(b.etype, b.len, b.on_interface);
+        c.skip(b.etype, b.len, b.apart);
     }
     Ok(())
 }
