@@ -278,3 +278,16 @@ gmsh.option.setNumber("Mesh.PartitionSplitMeshFiles", 1)
 gmsh.model.mesh.partition(2)
 write("split_41_ascii.msh", 4.1, 0)
 gmsh.finalize()
+
+# One surface in two physical groups: MSH 2.2 writes each triangle twice (once per group,
+# another element tag each time), 4.1 once, with both groups on the surface. The reader
+# keeps the first copy.
+start("two_groups")
+gmsh.model.occ.addRectangle(0, 0, 0, 1, 1)
+mesh(0.3)
+gmsh.model.addPhysicalGroup(2, [1], name="fluid")
+gmsh.model.addPhysicalGroup(2, [1], name="all")
+write("two_groups_41_ascii.msh", 4.1, 0)
+write("two_groups_22_ascii.msh", 2.2, 0)
+write("two_groups_22_bin.msh", 2.2, 1)
+gmsh.finalize()

@@ -1707,8 +1707,11 @@ fn ghost_cells_of_split_partition_files_are_skipped() {
     let mut union = BTreeSet::new();
     for name in ["split_41_ascii_1.msh", "split_41_ascii_2.msh"] {
         let file = msh::parse(&data(name), &std::fs::read(data(name)).unwrap()).unwrap();
-        let ghosts: Vec<&msh::SkippedElements> =
-            file.skipped.iter().filter(|k| k.ghost_cells).collect();
+        let ghosts: Vec<&msh::SkippedElements> = file
+            .skipped
+            .iter()
+            .filter(|k| k.why == msh::SkipReason::GhostCell)
+            .collect();
         assert!(
             ghosts.len() == 1 && ghosts[0].gmsh_type == 2 && ghosts[0].count > 0,
             "{name}: {ghosts:?}"
@@ -1739,7 +1742,7 @@ fn partition_interfaces_of_3d_meshes_are_skipped() {
         let interface: Vec<String> = file
             .skipped
             .iter()
-            .filter(|k| k.on_partition_interfaces)
+            .filter(|k| k.why == msh::SkipReason::PartitionInterface)
             .map(ToString::to_string)
             .collect();
         assert_eq!(

@@ -676,6 +676,46 @@ fn skipped_elements_on_missing_nodes_are_refused() {
     }
 }
 
+/// One surface in two physical groups: MSH 2.2 writes each triangle once per group (it was
+/// refused as a duplicate triangle). The copies are merged and counted as skipped, so the 2.2
+/// files read as the 4.1 file, and Gmsh reads both groups on the surface from our output.
+#[test]
+fn a_surface_in_two_physical_groups_reads_as_in_msh_41() {
+    let (m41, _) = load("two_groups_41_ascii.msh");
+    for name in ["two_groups_22_ascii.msh", "two_groups_22_bin.msh"] {
+        let file = msh::parse(&data(name), &std::fs::read(data(name)).unwrap()).unwrap();
+        let copies: Vec<String> = (file.skipped.iter())
+            .filter(|k| k.why == msh::SkipReason::GroupCopy)
+            .map(ToString::to_string)
+            .collect();
+        assert_eq!(
+            copies,
+            [format!(
+                "{} Triangle 3 (type 2) (copies for another physical group, merged)",
+                m41.num_triangles()
+            )],
+            "{name}"
+        );
+        let (m, _) = load(name);
+        assert_eq!(m.num_triangles(), m41.num_triangles(), "{name}");
+        assert_eq!(m.surfaces(), vec![1], "{name}");
+        let model = m.model.as_ref().expect("a model");
+        let surface = model.entities.iter().find(|e| (e.dim, e.tag) == (2, 1));
+        assert_eq!(surface.unwrap().physicals, vec![1, 2], "{name}");
+        if gmsh_available() {
+            let dir = tempfile::tempdir().unwrap();
+            let (out, rec) = write_recombined(dir.path(), "out.msh", &m, Rule::default());
+            let v = gmsh_reads(&out, "");
+            assert_eq!(
+                v["groups"],
+                serde_json::json!([[2, 1, "fluid", [1]], [2, 2, "all", [1]]]),
+                "{name}"
+            );
+            assert_eq!(v["elements"]["3"], rec.quads.len(), "{name}");
+        }
+    }
+}
+
 /// A node tag 0 is refused in every node reader, named where it is (tags are positive; Gmsh
 /// reads such a file but gives node 0 the tag of another node, so our output of it would not
 /// be what Gmsh then reads).

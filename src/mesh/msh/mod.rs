@@ -56,7 +56,8 @@ pub struct MshFile {
     pub version: MshVersion,
     /// Binary (true) or ASCII.
     pub binary: bool,
-    /// Elements of other types (points, lines, volumes, high order) that were skipped.
+    /// Elements that were skipped: of other types (points, lines, volumes, high order), on
+    /// partition interfaces, ghost cells, and MSH 2.2's copies for other physical groups.
     pub ignored_elements: usize,
     /// The same, per Gmsh element type (in increasing type number).
     pub skipped: Vec<SkippedElements>,
@@ -73,14 +74,25 @@ pub struct SkippedElements {
     pub dim: u8,
     /// How many were skipped.
     pub count: usize,
-    /// True for elements on the interfaces between the volume partitions of a partitioned
-    /// 3D mesh (MSH 4.1 partition surfaces whose parent is a volume): triangles inside the
-    /// volume, skipped whatever their type.
-    pub on_partition_interfaces: bool,
-    /// True for ghost cells: elements on a ghost entity of a partitioned mesh written one
-    /// file per partition (copies of the neighbouring partitions' elements), skipped
+    /// Why they were skipped.
+    pub why: SkipReason,
+}
+
+/// Why a reader skipped elements.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum SkipReason {
+    /// Their type: points, lines, volumes, high-order and other surface elements.
+    Type,
+    /// On the interfaces between the volume partitions of a partitioned 3D mesh (MSH 4.1
+    /// partition surfaces whose parent is a volume): triangles inside the volume, skipped
     /// whatever their type.
-    pub ghost_cells: bool,
+    PartitionInterface,
+    /// Ghost cells: on a ghost entity of a partitioned mesh written one file per partition
+    /// (copies of the neighbouring partitions' elements), skipped whatever their type.
+    GhostCell,
+    /// MSH 2.2 copies of a triangle or quad on a surface of two physical groups or more
+    /// (2.2 writes such an element once per group): the first is kept, in every group.
+    GroupCopy,
 }
 
 impl SkippedElements {
@@ -95,12 +107,12 @@ impl SkippedElements {
 impl fmt::Display for SkippedElements {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{} {} (type {})", self.count, self.name, self.gmsh_type)?;
-        if self.on_partition_interfaces {
-            f.write_str(" on partition interfaces")?;
-        }
-        if self.ghost_cells {
-            f.write_str(" (ghost cells)")?;
-        }
+        f.write_str(match self.why {
+            SkipReason::Type => "",
+            SkipReason::PartitionInterface => " on partition interfaces",
+            SkipReason::GhostCell => " (ghost cells)",
+            SkipReason::GroupCopy => " (copies for another physical group, merged)",
+        })?;
         Ok(())
     }
 }

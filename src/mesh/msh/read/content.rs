@@ -2,6 +2,7 @@
 //! skipped elements, partitions) and the parts of the file's model, with the functions
 //! that add an element to them.
 
+use super::element_types::{QUAD, TRIANGLE};
 use super::parser::{Parser, Res};
 use crate::mesh::MeshData;
 use crate::mesh::msh::model::{Element, Entity, Model, PhysicalName};
@@ -63,17 +64,7 @@ impl NodeMap {
     }
 }
 
-/// Where skipped elements were, when that is why they were skipped whatever their type.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub(super) enum Apart {
-    /// On a model entity (skipped for their type).
-    No,
-    /// On an interface between volume partitions (a surface inside a volume; see
-    /// `Content::interfaces`).
-    Interface,
-    /// On a ghost entity (see `Content::ghosts`).
-    Ghost,
-}
+use crate::mesh::msh::SkipReason;
 
 /// The content of a MSH file, before validation.
 pub(super) struct Content {
@@ -83,7 +74,7 @@ pub(super) struct Content {
     pub(super) tag_pos: Option<Vec<usize>>,
     pub(super) map: Option<NodeMap>,
     /// Skipped elements: count per Gmsh type and where they were.
-    pub(super) skipped: BTreeMap<(i64, Apart), usize>,
+    pub(super) skipped: BTreeMap<(i64, SkipReason), usize>,
     /// Partitioned files (4.1): the parent surface of each partition's surface entity.
     pub(super) parents: HashMap<i64, i32>,
     /// Partitioned 3D meshes (4.1): partition surfaces whose parent is a volume, the
@@ -263,7 +254,40 @@ impl Content {
     }
 
     /// Counts `n` skipped elements of type `etype` (on a partition interface or not).
-    pub(super) fn skip(&mut self, etype: i64, n: u64, apart: Apart) {
+    /// MSH 2.2 writes the elements of an entity in several physical groups once per group:
+    /// copies with the same nodes and elementary tag, another physical tag and element tag
+    /// (Gmsh reads each copy as an element of its own, and writes each of those once per
+    /// group again; MSH 4.1 lists the groups on the entity instead). On a surface of two
+    /// groups or more, keeps the first of each triangle and quad, in every group (the
+    /// surface holds the physical tags of all its copies), so that the mesh is the one the
+    /// 4.1 file gives; the copies dropped are counted as skipped.
+    pub(super) fn merge_group_copies(&mut self) {
+        let multi: HashSet<i32> = (self.model.element_entities.iter())
+            .filter(|&(&(dim, _), physicals)| dim == 2 && physicals.len() > 1)
+            .map(|(&(_, tag), _)| tag)
+            .collect();
+        if multi.is_empty() {
+            return;
+        }
+        let d = &mut self.data;
+        let keep_t = first_copies(&d.triangles, &d.triangle_surface, &multi);
+        let keep_q = first_copies(&d.quads, &d.quad_surface, &multi);
+        let dropped = |keep: &[bool]| keep.iter().filter(|&&k| !k).count() as u64;
+        let (nt, nq) = (dropped(&keep_t), dropped(&keep_q));
+        retain(&mut d.triangles, &keep_t);
+        retain(&mut d.triangle_ids, &keep_t);
+        retain(&mut d.triangle_surface, &keep_t);
+        retain(&mut d.quads, &keep_q);
+        retain(&mut d.quad_ids, &keep_q);
+        retain(&mut d.quad_surface, &keep_q);
+        for (etype, n) in [(TRIANGLE, nt), (QUAD, nq)] {
+            if n > 0 {
+                self.skip(etype, n, SkipReason::GroupCopy);
+            }
+        }
+    }
+
+    pub(super) fn skip(&mut self, etype: i64, n: u64, apart: SkipReason) {
         *self.skipped.entry((etype, apart)).or_default() += n as usize;
     }
 }
@@ -312,6 +336,35 @@ pub(super) fn check_block_nodes<T: Copy + std::fmt::Display>(
         }
     }
     unreachable!("a node that is not known was found")
+}
+
+/// Which of `elements` (on `surface`) to keep: all but the later copies of an element (same
+/// surface, same nodes in the same cyclic order) on the surfaces `multi` (those of two
+/// physical groups or more).
+fn first_copies<const N: usize>(
+    elements: &[[u32; N]],
+    surface: &[i32],
+    multi: &HashSet<i32>,
+) -> Vec<bool> {
+    let mut seen: HashSet<(i32, [u32; N])> = HashSet::new();
+    elements
+        .iter()
+        .zip(surface)
+        .map(|(e, &s)| {
+            let mut key = *e;
+            key.rotate_left((0..N).min_by_key(|&k| e[k]).unwrap_or(0));
+            !multi.contains(&s) || seen.insert((s, key))
+        })
+        .collect()
+}
+
+/// Keeps the items of `v` whose flag in `keep` is set.
+fn retain<T>(v: &mut Vec<T>, keep: &[bool]) {
+    let mut i = 0;
+    v.retain(|_| {
+        i += 1;
+        keep.get(i - 1).copied().unwrap_or(true)
+    });
 }
 
 fn missing_node(tag: impl std::fmt::Display, n: impl std::fmt::Display) -> String {

@@ -21,7 +21,7 @@ mod v41;
 use super::{MshFile, MshVersion, SkippedElements};
 use crate::mesh::ReadError;
 use crate::mesh::msh::model::PhysicalName;
-use content::{Apart, Content, NodeMap};
+use content::{Content, NodeMap};
 use parser::{Parser, Res, show, to_i32};
 use std::path::Path;
 use v22::{elements22_ascii, elements22_binary, nodes22_ascii, nodes22_binary, parametric_nodes22};
@@ -179,6 +179,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
                     (MshVersion::V22, false) => elements22_ascii(&mut p, &mut c, &map)?,
                     (MshVersion::V22, true) => elements22_binary(&mut p, &mut c, &map)?,
                 };
+                c.merge_group_copies();
                 p.end("$Elements", &|| format!("{n} elements"))?;
                 c.map = Some(map);
             }
@@ -240,8 +241,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
                     name,
                     dim,
                     count: n,
-                    on_partition_interfaces: apart == Apart::Interface,
-                    ghost_cells: apart == Apart::Ghost,
+                    why: apart,
                 }
             })
             .collect(),

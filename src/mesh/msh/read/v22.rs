@@ -2,13 +2,14 @@
 //! `$ParametricNodes` and `$Elements` (one element per record, its tags before its nodes).
 
 use super::content::{
-    Apart, Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
+    Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
 };
 use super::element_types::{
     MAX_LOWER_NODES, QUAD, TRIANGLE, element_nodes, element_type, is_lower, unknown_type,
     variable_size,
 };
 use super::parser::{Parser, Res, cap, check_finite, f64_at, i32_at, parse_u64, to_i32};
+use crate::mesh::msh::SkipReason;
 
 pub(super) fn nodes22_ascii(p: &mut Parser<'_>, c: &mut Content) -> Res<()> {
     let s = "$Nodes";
@@ -158,7 +159,7 @@ pub(super) fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMa
         let keep = etype == TRIANGLE || etype == QUAD;
         let lower = is_lower(dim, nn);
         if !keep {
-            c.skip(etype, 1, Apart::No);
+            c.skip(etype, 1, SkipReason::Type);
         }
         if nn == 0 {
             p.skip_line();
@@ -258,7 +259,7 @@ pub(super) fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeM
             check_block_nodes(p, map, data, at0, stride, nn, tag, node, key)?;
         }
         if !keep {
-            c.skip(etype, n as u64, Apart::No);
+            c.skip(etype, n as u64, SkipReason::Type);
         }
         seen += n as u64;
     }

@@ -3,13 +3,14 @@
 //! type).
 
 use super::content::{
-    Apart, Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
+    Content, NodeMap, check_block_nodes, check_node, parametric, push_element, push_lower,
 };
 use super::element_types::{
     MAX_LOWER_NODES, QUAD, TRIANGLE, element_nodes, element_type, is_lower, unknown_type,
     variable_size,
 };
 use super::parser::{Parser, Res, cap, check_finite, f64_at, parse_u64, to_i32, u64_at};
+use crate::mesh::msh::SkipReason;
 use crate::mesh::msh::model::Entity;
 
 /// The `$PartitionedEntities` section of MSH 4.1 (a mesh split into partitions, whose
@@ -380,11 +381,13 @@ pub(super) fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> 
             nodes,
             surface,
             apart: match entity_dim {
-                2 if c.interfaces.contains(&entity) => Apart::Interface,
+                2 if c.interfaces.contains(&entity) => SkipReason::PartitionInterface,
                 // A ghost entity is of the mesh's dimension; a surface of that tag that
                 // `$PartitionedEntities` declares is a partition's own.
-                2 if c.ghosts.contains(&entity) && !c.parents.contains_key(&entity) => Apart::Ghost,
-                _ => Apart::No,
+                2 if c.ghosts.contains(&entity) && !c.parents.contains_key(&entity) => {
+                    SkipReason::GhostCell
+                }
+                _ => SkipReason::Type,
             },
         };
         if block.keep() || block.lower() {
@@ -444,13 +447,13 @@ struct Block41 {
     /// The entity the elements are on.
     surface: i32,
     /// Whether the block is on a partition interface or a ghost entity (then skipped).
-    apart: Apart,
+    apart: SkipReason,
 }
 
 impl Block41 {
     /// Whether the block's elements are read: triangles and quads not on an interface.
     fn keep(&self) -> bool {
-        (self.etype == TRIANGLE || self.etype == QUAD) && self.apart == Apart::No
+        (self.etype == TRIANGLE || self.etype == QUAD) && self.apart == SkipReason::Type
     }
 
     /// Whether the block's elements go to the model: points and lines.
