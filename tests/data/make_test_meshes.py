@@ -291,3 +291,15 @@ write("two_groups_41_ascii.msh", 4.1, 0)
 write("two_groups_22_ascii.msh", 2.2, 0)
 write("two_groups_22_bin.msh", 2.2, 1)
 gmsh.finalize()
+
+# A box of tetrahedra in MSH 2.2 with a volume group and a surface group: 2.2 has no
+# $Entities, so the volume and the nodes inside it are known from the tetrahedra alone.
+start("box_groups")
+gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+gmsh.model.occ.synchronize()
+gmsh.model.addPhysicalGroup(3, [1], name="vol")
+gmsh.model.addPhysicalGroup(2, [1, 2, 3, 4, 5, 6], name="skin")
+mesh(0.3, dim=3)
+write("box_groups_22_ascii.msh", 2.2, 0)
+write("box_groups_22_bin.msh", 2.2, 1)
+gmsh.finalize()

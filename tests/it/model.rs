@@ -716,6 +716,27 @@ fn a_surface_in_two_physical_groups_reads_as_in_msh_41() {
     }
 }
 
+/// A volume mesh in MSH 2.2 (no `$Entities`): the volume and its group are known from the
+/// tetrahedra, and the nodes inside it are on it, as Gmsh reads the file (they were written
+/// on surface 1, the volume and its group lost). Gmsh reads from our output the input's
+/// groups, entities and every entity's nodes.
+#[test]
+fn msh22_volume_meshes_keep_their_volume_and_its_nodes() {
+    if !gmsh_available() {
+        return;
+    }
+    for name in ["box_groups_22_ascii.msh", "box_groups_22_bin.msh"] {
+        let (m, input) = load(name);
+        let dir = tempfile::tempdir().unwrap();
+        let (out, _) = write_recombined(dir.path(), "out.msh", &m, Rule::default());
+        let (got, want) = (gmsh_reads(&out, ""), gmsh_reads(&input, ""));
+        assert_eq!(got["groups"], want["groups"], "{name}");
+        assert_eq!(got["entities"], want["entities"], "{name}");
+        assert!(want["nodes"]["3 1"].as_array().unwrap().len() > 1, "{name}");
+        assert_eq!(got["nodes"], want["nodes"], "{name}");
+    }
+}
+
 /// A node tag 0 is refused in every node reader, named where it is (tags are positive; Gmsh
 /// reads such a file but gives node 0 the tag of another node, so our output of it would not
 /// be what Gmsh then reads).

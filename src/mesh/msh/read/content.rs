@@ -113,6 +113,9 @@ pub(super) struct ModelParts {
     pub(super) last_entity: Option<(u8, i32, i32)>,
     /// Partitioned files (4.1): the parent (dimension, tag) of each partition entity.
     pub(super) parents: HashMap<(u8, i32), (u8, i32)>,
+    /// MSH 2.2: the volume of a volume element holding each node (the first such element
+    /// in the file; empty when the file has none), for the nodes no lower element holds.
+    pub(super) node_volume: Vec<Option<i32>>,
 }
 
 impl ModelParts {
@@ -123,6 +126,16 @@ impl ModelParts {
             self.node_param.resize(self.node_entity.len() - 1, None);
             self.node_param.push(u);
         }
+    }
+
+    /// Notes that node `v` (an index) is a node of a volume element on volume `tag` (MSH 2.2).
+    #[inline]
+    pub(super) fn in_volume(&mut self, v: u32, tag: i32) {
+        let v = v as usize;
+        if self.node_volume.len() <= v {
+            self.node_volume.resize(v + 1, None);
+        }
+        self.node_volume[v].get_or_insert(tag);
     }
 
     /// Notes an element of dimension `dim` on entity `tag` in physical group `physical`
@@ -204,6 +217,11 @@ impl ModelParts {
             }
             for (q, &s) in data.quads.iter().zip(&data.quad_surface) {
                 classify(q, 2, s);
+            }
+            for (slot, volume) in on.iter_mut().zip(&self.node_volume) {
+                if let (None, Some(tag)) = (*slot, volume) {
+                    *slot = Some((3, *tag));
+                }
             }
         }
         let mut entities = self.entities.unwrap_or_default();

@@ -165,12 +165,24 @@ pub(super) fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMa
             p.skip_line();
             continue;
         }
+        let volume = if dim == 3 {
+            let used = &tags[..(ntags as usize).min(2)];
+            let entity = to_i32(p, at, surface22(used), "elementary tag")?;
+            c.model
+                .on_entity(3, entity, to_i32(p, at, tags[0], "physical tag")?);
+            Some(entity)
+        } else {
+            None
+        };
         for k in 0..nn {
             let v = p.uint(s, &|| format!("node {} of element {tag}", k + 1))?;
             if let (true, Some(slot)) = (keep || lower, nodes.get_mut(k)) {
                 *slot = v;
             } else {
                 check_node(p, map, at, tag, v)?;
+                if let (Some(entity), Some(i)) = (volume, map.get(v)) {
+                    c.model.in_volume(i, entity);
+                }
             }
         }
         p.entry_end(&|| element_nodes(tag, etype, nn))?;
@@ -257,6 +269,18 @@ pub(super) fn elements22_binary(p: &mut Parser<'_>, c: &mut Content, map: &NodeM
             // A negative node tag is looked up as 0, which no node has (tags are positive).
             let key = |v: i32| u64::try_from(v).unwrap_or(0);
             check_block_nodes(p, map, data, at0, stride, nn, tag, node, key)?;
+            if dim == 3 {
+                for e in data.chunks_exact(stride) {
+                    let physical = if ntags >= 1 { i32_at(e, 4) } else { 0 };
+                    let volume = if ntags >= 2 { i32_at(e, 8) } else { 0 };
+                    c.model.on_entity(3, volume, physical);
+                    for k in 0..nn {
+                        if let Some(i) = map.get(key(node(e, k))) {
+                            c.model.in_volume(i, volume);
+                        }
+                    }
+                }
+            }
         }
         if !keep {
             c.skip(etype, n as u64, SkipReason::Type);
