@@ -303,3 +303,36 @@ mesh(0.3, dim=3)
 write("box_groups_22_ascii.msh", 2.2, 0)
 write("box_groups_22_bin.msh", 2.2, 1)
 gmsh.finalize()
+
+# Nodes that MSH 2.2 does not classify, held by elements of two entities of one dimension:
+# Gmsh gives them the entity of lowest tag (triangles before quads on one surface), whatever
+# the order of the elements in the file, which 2.2 writes type by type. Two squares, quads on
+# surface 1 and triangles on surface 2, no lines saved; then prisms (volume 1) under
+# tetrahedra (volume 2), their common face in no group (no triangles there).
+start("order_surfaces")
+occ = gmsh.model.occ
+occ.addRectangle(0, 0, 0, 1, 1)
+occ.addRectangle(1, 0, 0, 1, 1)
+occ.fragment([(2, 1)], [(2, 2)])
+occ.synchronize()
+gmsh.model.addPhysicalGroup(2, [1], name="L")
+gmsh.model.addPhysicalGroup(2, [2], name="R")
+gmsh.model.mesh.setRecombine(2, 1)
+mesh(0.3)
+write("order_surfaces_22_ascii.msh", 2.2, 0)
+gmsh.finalize()
+
+start("order_volumes")
+geo = gmsh.model.geo
+p = [geo.addPoint(x, y, 0, 0.4) for x, y in ((0, 0), (1, 0), (1, 1), (0, 1))]
+lines = [geo.addLine(p[k], p[(k + 1) % 4]) for k in range(4)]
+s = geo.addPlaneSurface([geo.addCurveLoop(lines)])
+top = geo.extrude([(2, s)], 0, 0, 1, numElements=[2], recombine=True)[0][1]
+geo.extrude([(2, top)], 0, 0, 1)
+geo.synchronize()
+gmsh.model.addPhysicalGroup(3, [1], name="prisms")
+gmsh.model.addPhysicalGroup(3, [2], name="tets")
+gmsh.model.addPhysicalGroup(2, [s], name="bottom")
+gmsh.model.mesh.generate(3)
+write("order_volumes_22_ascii.msh", 2.2, 0)
+gmsh.finalize()

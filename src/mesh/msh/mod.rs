@@ -90,8 +90,9 @@ pub enum SkipReason {
     /// Ghost cells: on a ghost entity of a partitioned mesh written one file per partition
     /// (copies of the neighbouring partitions' elements), skipped whatever their type.
     GhostCell,
-    /// MSH 2.2 copies of a triangle or quad on a surface of two physical groups or more
-    /// (2.2 writes such an element once per group): the first is kept, in every group.
+    /// Exact copies of an element on an entity of two physical groups or more (MSH 2.2
+    /// writes such an element once per group; Gmsh's re-saves of such a file repeat them):
+    /// the first is kept, in every group.
     GroupCopy,
 }
 

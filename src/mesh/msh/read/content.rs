@@ -113,8 +113,8 @@ pub(super) struct ModelParts {
     pub(super) last_entity: Option<(u8, i32, i32)>,
     /// Partitioned files (4.1): the parent (dimension, tag) of each partition entity.
     pub(super) parents: HashMap<(u8, i32), (u8, i32)>,
-    /// MSH 2.2: the volume of a volume element holding each node (the first such element
-    /// in the file; empty when the file has none), for the nodes no lower element holds.
+    /// MSH 2.2: the lowest tag of the volumes whose elements hold each node (empty when the
+    /// file has no volume element), for the nodes no lower element holds.
     pub(super) node_volume: Vec<Option<i32>>,
 }
 
@@ -135,7 +135,8 @@ impl ModelParts {
         if self.node_volume.len() <= v {
             self.node_volume.resize(v + 1, None);
         }
-        self.node_volume[v].get_or_insert(tag);
+        let slot = &mut self.node_volume[v];
+        *slot = Some(slot.map_or(tag, |t| t.min(tag)));
     }
 
     /// Notes an element of dimension `dim` on entity `tag` in physical group `physical`
@@ -155,8 +156,9 @@ impl ModelParts {
     /// The model: partition entities replaced by their parents (elements and node
     /// classifications on partition interfaces dropped, the parametric coordinates of a
     /// node moved to a parent of another dimension dropped), nodes the file does not
-    /// classify put on the entity of the lowest-dimension element that holds them (as Gmsh
-    /// reads MSH 2.2), and entities that `$Entities` lacks derived from the elements.
+    /// classify put on the entity of the lowest dimension, then tag, whose elements hold
+    /// them (as Gmsh reads MSH 2.2), and entities that `$Entities` lacks derived from the
+    /// elements.
     pub(super) fn finish(mut self, data: &MeshData) -> Model {
         if !self.parents.is_empty() {
             let parents = &self.parents;
@@ -199,28 +201,36 @@ impl ModelParts {
             self.node_param.resize(nv, None);
         }
         if self.node_entity.iter().any(Option::is_none) {
-            let on = &mut self.node_entity;
-            let mut classify = |nodes: &[u32], dim: u8, tag: i32| {
+            // As Gmsh reads MSH 2.2 (its entities walked by dimension, then tag, each
+            // claiming the nodes not yet claimed): among the elements that hold a node, the
+            // lowest dimension, then the lowest entity tag, then triangles before quads.
+            let on = &self.node_entity;
+            let mut best: Vec<Option<(u8, i32, u8)>> = vec![None; nv];
+            let mut claim = |nodes: &[u32], key: (u8, i32, u8)| {
                 for &v in nodes {
-                    if let Some(slot @ None) = on.get_mut(v as usize) {
-                        *slot = Some((dim, tag));
+                    let v = v as usize;
+                    if on.get(v).is_some_and(Option::is_none) && best[v].is_none_or(|b| key < b) {
+                        best[v] = Some(key);
                     }
                 }
             };
-            for dim in [0, 1] {
-                for e in self.elements.iter().filter(|e| e.dim == dim) {
-                    classify(&e.nodes, dim, e.entity);
-                }
+            for e in self.elements.iter().filter(|e| e.dim <= 1) {
+                claim(&e.nodes, (e.dim, e.entity, 0));
             }
             for (t, &s) in data.triangles.iter().zip(&data.triangle_surface) {
-                classify(t, 2, s);
+                claim(t, (2, s, 0));
             }
             for (q, &s) in data.quads.iter().zip(&data.quad_surface) {
-                classify(q, 2, s);
+                claim(q, (2, s, 1));
             }
-            for (slot, volume) in on.iter_mut().zip(&self.node_volume) {
-                if let (None, Some(tag)) = (*slot, volume) {
-                    *slot = Some((3, *tag));
+            for (v, volume) in self.node_volume.iter().enumerate() {
+                if let Some(tag) = *volume {
+                    claim(&[v as u32], (3, tag, 0));
+                }
+            }
+            for (slot, b) in self.node_entity.iter_mut().zip(best) {
+                if slot.is_none() {
+                    *slot = b.map(|(dim, tag, _)| (dim, tag));
                 }
             }
         }
@@ -275,21 +285,35 @@ impl Content {
     /// MSH 2.2 writes the elements of an entity in several physical groups once per group:
     /// copies with the same nodes and elementary tag, another physical tag and element tag
     /// (Gmsh reads each copy as an element of its own, and writes each of those once per
-    /// group again; MSH 4.1 lists the groups on the entity instead). On a surface of two
-    /// groups or more, keeps the first of each triangle and quad, in every group (the
-    /// surface holds the physical tags of all its copies), so that the mesh is the one the
-    /// 4.1 file gives; the copies dropped are counted as skipped.
+    /// group again, in 2.2 and in 4.1; MSH 4.1 lists the groups on the entity instead). On an
+    /// entity of two groups or more, keeps the first of each element (triangle and quad,
+    /// point and line), in every group (the entity holds the physical tags of all its
+    /// copies), so that the mesh and its groups are the ones Gmsh's 4.1 file of the model
+    /// gives; an exact copy there is dropped whatever its group (Gmsh's re-saves repeat a
+    /// group's copy). The copies dropped are counted as skipped.
     pub(super) fn merge_group_copies(&mut self) {
-        let multi: HashSet<i32> = (self.model.element_entities.iter())
-            .filter(|&(&(dim, _), physicals)| dim == 2 && physicals.len() > 1)
-            .map(|(&(_, tag), _)| tag)
+        let mut multi: HashSet<(u8, i32)> = (self.model.element_entities.iter())
+            .filter(|(_, physicals)| physicals.len() > 1)
+            .map(|(&key, _)| key)
             .collect();
+        if let Some(entities) = &self.model.entities {
+            multi.extend(
+                entities
+                    .iter()
+                    .filter(|e| e.physicals.len() > 1)
+                    .map(|e| (e.dim, e.tag)),
+            );
+        }
         if multi.is_empty() {
             return;
         }
+        let surfaces: HashSet<i32> = (multi.iter())
+            .filter(|&&(dim, _)| dim == 2)
+            .map(|&(_, tag)| tag)
+            .collect();
         let d = &mut self.data;
-        let keep_t = first_copies(&d.triangles, &d.triangle_surface, &multi);
-        let keep_q = first_copies(&d.quads, &d.quad_surface, &multi);
+        let keep_t = first_copies(&d.triangles, &d.triangle_surface, &surfaces);
+        let keep_q = first_copies(&d.quads, &d.quad_surface, &surfaces);
         let dropped = |keep: &[bool]| keep.iter().filter(|&&k| !k).count() as u64;
         let (nt, nq) = (dropped(&keep_t), dropped(&keep_q));
         retain(&mut d.triangles, &keep_t);
@@ -302,6 +326,20 @@ impl Content {
             if n > 0 {
                 self.skip(etype, n, SkipReason::GroupCopy);
             }
+        }
+        // Points and lines: the same element (type, entity, nodes as written) again.
+        let mut seen = HashSet::new();
+        let mut lower = BTreeMap::new();
+        self.model.elements.retain(|e| {
+            let copy = multi.contains(&(e.dim, e.entity))
+                && !seen.insert((e.gmsh_type, e.dim, e.entity, e.nodes.clone()));
+            if copy {
+                *lower.entry(e.gmsh_type).or_insert(0u64) += 1;
+            }
+            !copy
+        });
+        for (etype, n) in lower {
+            self.skip(etype, n, SkipReason::GroupCopy);
         }
     }
 

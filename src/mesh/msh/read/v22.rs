@@ -161,10 +161,6 @@ pub(super) fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMa
         if !keep {
             c.skip(etype, 1, SkipReason::Type);
         }
-        if nn == 0 {
-            p.skip_line();
-            continue;
-        }
         let volume = if dim == 3 {
             let used = &tags[..(ntags as usize).min(2)];
             let entity = to_i32(p, at, surface22(used), "elementary tag")?;
@@ -174,6 +170,10 @@ pub(super) fn elements22_ascii(p: &mut Parser<'_>, c: &mut Content, map: &NodeMa
         } else {
             None
         };
+        if nn == 0 {
+            p.skip_line();
+            continue;
+        }
         for k in 0..nn {
             let v = p.uint(s, &|| format!("node {} of element {tag}", k + 1))?;
             if let (true, Some(slot)) = (keep || lower, nodes.get_mut(k)) {
