@@ -57,7 +57,7 @@ pub struct MshFile {
     /// Binary (true) or ASCII.
     pub binary: bool,
     /// Elements that were skipped: of other types (points, lines, volumes, high order), on
-    /// partition interfaces, ghost cells, and MSH 2.2's copies for other physical groups.
+    /// partition interfaces, ghost cells, and copies of an element for other physical groups.
     pub ignored_elements: usize,
     /// The same, per Gmsh element type (in increasing type number).
     pub skipped: Vec<SkippedElements>,

@@ -5,6 +5,7 @@
 use super::element_types::{QUAD, TRIANGLE};
 use super::parser::{Parser, Res};
 use crate::mesh::MeshData;
+use crate::mesh::msh::SkipReason;
 use crate::mesh::msh::model::{Element, Entity, Model, PhysicalName};
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
@@ -63,8 +64,6 @@ impl NodeMap {
         }
     }
 }
-
-use crate::mesh::msh::SkipReason;
 
 /// The content of a MSH file, before validation.
 pub(super) struct Content {
@@ -281,7 +280,6 @@ impl Content {
         }
     }
 
-    /// Counts `n` skipped elements of type `etype` (on a partition interface or not).
     /// MSH 2.2 writes the elements of an entity in several physical groups once per group:
     /// copies with the same nodes and elementary tag, another physical tag and element tag
     /// (Gmsh reads each copy as an element of its own, and writes each of those once per
@@ -347,8 +345,9 @@ impl Content {
         }
     }
 
-    pub(super) fn skip(&mut self, etype: i64, n: u64, apart: SkipReason) {
-        *self.skipped.entry((etype, apart)).or_default() += n as usize;
+    /// Counts `n` skipped elements of type `etype`, skipped for `why`.
+    pub(super) fn skip(&mut self, etype: i64, n: u64, why: SkipReason) {
+        *self.skipped.entry((etype, why)).or_default() += n as usize;
     }
 }
 

@@ -234,14 +234,14 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
         skipped: c
             .skipped
             .into_iter()
-            .map(|((t, apart), n)| {
+            .map(|((t, why), n)| {
                 let (_, dim, name) = element_type(t).expect("skipped types are known");
                 SkippedElements {
                     gmsh_type: t,
                     name,
                     dim,
                     count: n,
-                    why: apart,
+                    why,
                 }
             })
             .collect(),

@@ -380,7 +380,7 @@ pub(super) fn elements41(p: &mut Parser<'_>, c: &mut Content, map: &NodeMap) -> 
             dim,
             nodes,
             surface,
-            apart: match entity_dim {
+            why: match entity_dim {
                 2 if c.interfaces.contains(&entity) => SkipReason::PartitionInterface,
                 // A ghost entity is of the mesh's dimension; a surface of that tag that
                 // `$PartitionedEntities` declares is a partition's own.
@@ -447,13 +447,13 @@ struct Block41 {
     /// The entity the elements are on.
     surface: i32,
     /// Whether the block is on a partition interface or a ghost entity (then skipped).
-    apart: SkipReason,
+    why: SkipReason,
 }
 
 impl Block41 {
     /// Whether the block's elements are read: triangles and quads not on an interface.
     fn keep(&self) -> bool {
-        (self.etype == TRIANGLE || self.etype == QUAD) && self.apart == SkipReason::Type
+        (self.etype == TRIANGLE || self.etype == QUAD) && self.why == SkipReason::Type
     }
 
     /// Whether the block's elements go to the model: points and lines.
@@ -511,7 +511,7 @@ fn element_block41_ascii(
         }
     }
     if !keep {
-        c.skip(b.etype, b.len, b.apart);
+        c.skip(b.etype, b.len, b.why);
     }
     Ok(())
 }
@@ -551,7 +551,7 @@ fn element_block41_binary(
         check_block_nodes(p, map, data, at0, stride, nn, tag, node, |v| v)?;
     }
     if !b.keep() {
-        c.skip(b.etype, b.len, b.apart);
+        c.skip(b.etype, b.len, b.why);
     }
     Ok(())
 }
