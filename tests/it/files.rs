@@ -1233,7 +1233,6 @@ fn results_paths_that_cannot_work_are_refused_before_any_run() {
     let out = run_in(dir, &small_sweep_args("f"));
     assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
     assert!(!dir.join("f/runs.jsonl").exists());
-    // `report` on a results directory with one: exit 3 naming it, nothing written.
     let out = run_in(dir, &small_sweep_args("s"));
     assert!(out.status.success(), "{}", stderr(&out));
     // `report` with a file it writes linked into a missing directory: exit 3 naming the
@@ -1250,6 +1249,8 @@ fn results_paths_that_cannot_work_are_refused_before_any_run() {
     );
     assert!(!dir.join("s/report.md").exists());
     std::fs::remove_file(dir.join("s/report.html")).unwrap();
+    // `report` on a results directory with a file `figures`: exit 3 naming it, nothing
+    // written.
     std::fs::remove_dir_all(dir.join("s/figures")).ok();
     std::fs::write(dir.join("s/figures"), "mine").unwrap();
     let out = run_in(dir, &["report", "s"]);

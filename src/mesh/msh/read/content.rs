@@ -415,8 +415,8 @@ fn first_copies<const N: usize>(
     };
     let mut keep = vec![true; elements.len()];
     // Most surfaces of two groups hold no copy (every 4.1 file with such a surface, but
-    // for Gmsh's re-saves of 2.2 files): a sort of 64-bit fingerprints says so at a fifth
-    // of the cost of the exact sort below.
+    // for Gmsh's re-saves of 2.2 files): a sort of 64-bit fingerprints says so for less
+    // than the exact sort below (measured in c90bcfe's message).
     let mut prints: Vec<u64> = (elements.iter().zip(surface))
         .filter(|(_, s)| on_multi(s))
         .map(|(e, &s)| {
