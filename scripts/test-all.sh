@@ -11,14 +11,31 @@ if ! ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1; then
   sudo_if_needed apt-get update -qq
   sudo_if_needed env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers
 fi
-if ! python3 -c "import gmsh" >/dev/null 2>&1; then
-  echo "== installing gmsh 4.15.2 from PyPI (tests and data only)"
-  python3 -m pip install -q gmsh==4.15.2 || echo "warning: could not install gmsh; its round-trip tests will skip"
-fi
-for mod in meshio==5.3.5 vtk==9.7.2 scipy==1.17.1; do
+# Python tools from PyPI: Gmsh (tests and data only), meshio and VTK (read our .msh/.vtu
+# files), scipy (checks our statistics). Where the system's Python refuses pip installs
+# (Debian and Ubuntu mark it externally managed, PEP 668) or has no pip, they go into a
+# virtual environment under target/ that still sees the system's packages, put first on
+# the PATH for the tests' python3.
+venv="$PWD/target/test-venv"
+if [ -x "$venv/bin/python3" ]; then export PATH="$venv/bin:$PATH"; fi
+pip_install() {
+  python3 -m pip install -q "$1" 2>/dev/null && return 0
+  [ -x "$venv/bin/python3" ] && return 1
+  echo "== this Python takes no pip installs: making a virtual environment in $venv"
+  if ! python3 -m venv --system-site-packages "$venv" >/dev/null 2>&1 \
+    || ! "$venv/bin/python3" -m pip --version >/dev/null 2>&1; then
+    rm -rf "$venv"
+    sudo_if_needed apt-get update -qq
+    sudo_if_needed env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-venv python3-pip
+    python3 -m venv --system-site-packages "$venv" || return 1
+  fi
+  export PATH="$venv/bin:$PATH"
+  python3 -m pip install -q "$1"
+}
+for mod in gmsh==4.15.2 meshio==5.3.5 vtk==9.7.2 scipy==1.17.1; do
   if ! python3 -c "import ${mod%%==*}" >/dev/null 2>&1; then
-    echo "== installing $mod from PyPI (reads our .msh/.vtu files, checks our statistics in the tests)"
-    python3 -m pip install -q "$mod" || echo "warning: could not install $mod; its checks will skip outside CI"
+    echo "== installing $mod from PyPI"
+    pip_install "$mod" || echo "warning: could not install $mod; its checks will skip outside CI"
   fi
 done
 

@@ -12,6 +12,8 @@ const WARN_ABOVE_S: f64 = 60.0;
 const ESTIMATE_AFTER_S: f64 = 1.0;
 /// The bar appears once the run has lasted this long.
 const BAR_AFTER_S: f64 = 2.0;
+/// The bar is updated at most this often.
+const REDRAW_S: f64 = 0.1;
 
 /// The run's total time extrapolated from its progress so far (triangles recombined per
 /// second), or `None` before anything is recombined.
@@ -47,7 +49,7 @@ pub fn cost_warning(p: &Progress, horizon: Option<u32>) -> Option<String> {
         100.0 * p.recombined as f64 / p.triangles as f64,
         p.elapsed_s
     );
-    // Uniform builds a tree per decision and counts none apart.
+    // Uniform h = 1 runs greedy, which counts its trees (one per quad) only at the end.
     let trees = if p.trees > 0 {
         p.trees
     } else {
@@ -84,6 +86,7 @@ pub fn attach(searcher: &mut Searcher<'_>, horizon: Option<u32>) -> ProgressBar 
     let shown = bar.clone();
     let mut warned = false;
     let mut visible = false;
+    let mut drawn_at = f64::NEG_INFINITY;
     searcher.set_progress(move |p| {
         // Estimated at every report once the run has lasted a second (the later trees can
         // be the larger ones), said once.
@@ -94,9 +97,12 @@ pub fn attach(searcher: &mut Searcher<'_>, horizon: Option<u32>) -> ProgressBar 
             warned = true;
             shown.suspend(|| noteln!("{w}"));
         }
-        if p.elapsed_s < BAR_AFTER_S {
+        // Reports come every few hundred tree nodes; the bar is redrawn at most every
+        // REDRAW_S.
+        if p.elapsed_s < BAR_AFTER_S || p.elapsed_s < drawn_at + REDRAW_S {
             return;
         }
+        drawn_at = p.elapsed_s;
         if !visible {
             visible = true;
             shown.set_length(p.triangles as u64);

@@ -21,8 +21,9 @@ pub struct Args {
     /// (repeatable; default: the best horizon of each look-ahead algorithm).
     #[arg(long = "picture", value_name = "ALGO[:H]")]
     pictures: Vec<String>,
-    /// Leave out the mesh pictures (they re-run each typical run).
-    #[arg(long)]
+    /// Leave out the mesh pictures (they re-run each typical run); not with `--picture` or
+    /// `--zoom`, which ask for pictures.
+    #[arg(long, conflicts_with_all = ["pictures", "zoom"])]
     no_pictures: bool,
     /// Across meshes (two or more): the method every other is compared with, as the report
     /// names it, e.g. "selective h=3" (default: selective h=1, else the first method run on

@@ -204,7 +204,7 @@ pub const SUITES: &[(&str, &[&str], &str)] = &[
             "odd-pieces",
             "borouchaki",
         ],
-        "every member but grid-1m (about 2 s a run: minutes more for the sweep)",
+        "every member but grid-1m (whose runs take about 2 s each: minutes more for the sweep)",
     ),
     (
         "small",

@@ -75,11 +75,14 @@ impl Searcher<'_> {
         Some((t, self.state.tree_allowed_mask(t)))
     }
 
-    /// Counts one node expanded (children generated) and reports progress every 2^16 nodes.
+    /// Counts one node expanded (children generated) and reports progress every 2^8 nodes:
+    /// often enough for deep trees, whose nodes cost more (uniform on `sphere`: about
+    /// 0.5 ms a node at h = 20, 11 ms at h = 40), to be reported within a few seconds; a
+    /// report without a callback is one branch.
     #[inline]
     pub(super) fn count_node(&mut self) {
         self.nodes += 1;
-        if self.nodes & 0xFFFF == 0 {
+        if self.nodes & 0xFF == 0 {
             let quads = self.state.quads();
             self.tick(quads);
         }

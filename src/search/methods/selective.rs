@@ -140,11 +140,7 @@ impl Searcher<'_> {
             bound.leaf(partial);
             return 0.0;
         };
-        self.nodes += 1;
-        if self.nodes & 0xFFFF == 0 {
-            let quads = self.state.quads();
-            self.tick(quads);
-        }
+        self.count_node();
         let mut kids = [(-1.0, NONE); 3];
         for (i, c) in self.state.candidates_of(t).into_iter().enumerate() {
             if allowed & (1 << i) != 0 {

@@ -60,6 +60,8 @@ impl Searcher<'_> {
                 break;
             }
             self.state.apply(first);
+            // One tree per quad (the run's count, set again when it ends).
+            self.trees += 1;
             let quads = self.state.quads();
             self.tick(quads);
         }
@@ -154,11 +156,7 @@ impl Searcher<'_> {
             any = true;
             if !expanded {
                 expanded = true;
-                self.nodes += 1;
-                if self.nodes & 0xFFFF == 0 {
-                    let quads = self.state.quads();
-                    self.tick(quads);
-                }
+                self.count_node();
             }
             let r = if d == 0 { c } else { root };
             if d + 1 == h {
