@@ -922,7 +922,10 @@ fn report_command_writes_files_and_rejects_bad_input() {
     }
     // Pictures asked for and refused at once is a usage error, not one of them ignored.
     for asked in [["--picture", "selective:1"], ["--zoom", "0,0,1,1"]] {
-        let out = run_in(tmp.path(), &["report", "res", "--no-pictures", asked[0], asked[1]]);
+        let out = run_in(
+            tmp.path(),
+            &["report", "res", "--no-pictures", asked[0], asked[1]],
+        );
         assert_eq!(out.status.code(), Some(2), "{}", err(&out));
         assert!(
             err(&out).contains("'--no-pictures' cannot be used with"),
