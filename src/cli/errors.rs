@@ -7,7 +7,7 @@
 //! | 1 | any other failure (a file the system cannot read or write, no GPU, a bug) |
 //! | 2 | usage error: an unknown flag or a value it refuses (clap), a value out of range |
 //! | 3 | bad input: a mesh file unreadable or invalid, a results directory whose files are corrupt or do not form one sweep |
-//! | 4 | the results directory cannot be used: it holds other runs or another configuration, another sweep is writing it, or it is not a directory or lies under a file |
+//! | 4 | the results directory cannot be used: it holds other runs or another configuration, another sweep, merge or report is writing it, or it is not a directory or lies under a file |
 //! | 5 | out of memory ([`super::oom`]; the GPU's too: [`GpuError::OutOfMemory`]) |
 //! | 130 | interrupted (Ctrl-C, SIGTERM or SIGHUP) |
 
@@ -220,7 +220,9 @@ fn flag_wording(e: &(dyn Error + 'static)) -> Option<String> {
             format!("{e}: choose another --out or remove that one")
         }
         e @ E::ForeignFiles { .. } => format!("{e}; choose another --out or move them"),
-        e @ E::Busy { .. } => format!("{e}; wait for it, stop it, or choose another --out"),
+        e @ E::Busy { .. } => {
+            format!("{e}; wait for it or stop it (or give a sweep or merge another --out)")
+        }
         E::NotADirectory { dir, kind } => format!(
             "--out {}: is {kind}, not a directory (results go into a directory)",
             dir.display()

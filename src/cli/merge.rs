@@ -37,6 +37,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut report = serde_json::Value::Null;
     if !args.no_report {
         let out = &args.out;
+        let _lock = quadrecomb::internals::experiment::lock::DirLock::acquire(out)?;
         let paths = quadrecomb::internals::report::write(
             out,
             &quadrecomb::internals::report::ReportOptions::default(),

@@ -1,6 +1,7 @@
 //! `quadrecomb report DIR [--compare DIR2] [--zoom x0,y0,x1,y1]`.
 
 use super::UsageError;
+use quadrecomb::internals::experiment::lock::DirLock;
 use quadrecomb::internals::report::{self, ReportOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -104,6 +105,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         seed: args.seed,
         baseline: args.baseline,
     };
+    // The directory's writers take turns: a report written while a sweep or merge is
+    // writing there would put a summary of fewer runs over theirs. (A missing directory or
+    // a file is left to `report::write`, which names it.)
+    let _lock = args
+        .dir
+        .is_dir()
+        .then(|| DirLock::acquire(&args.dir))
+        .transpose()?;
     // Its exit code follows the error's kind (`errors::exit_code`).
     let paths = report::write(&args.dir, &opts)?;
     if args.json {

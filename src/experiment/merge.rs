@@ -16,7 +16,7 @@ use super::engine::check_records;
 use super::manifest::{MANIFEST_FILE, Manifest, MergedPart};
 use super::plan::plan;
 use super::record::{RunKey, RunRecord};
-use super::store::{self, RUNS_FILE, RunLog};
+use super::store::{self, RUNS_FILE};
 use super::summary;
 
 /// What a merge wrote.
@@ -202,6 +202,9 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
         )));
     }
     std::fs::create_dir_all(out).map_err(|e| ExperimentError::io(out, e))?;
+    // One writer at a time, as for a sweep: a sweep or another merge writing `out` now is
+    // refused, and none can start there until this merge ends.
+    let _lock = super::lock::DirLock::acquire(out)?;
     let out_runs = out.join(RUNS_FILE);
     let existing = store::read(&out_runs)?;
     if !existing.records.is_empty() || existing.torn_bytes > 0 {
@@ -218,14 +221,19 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     manifest.machine = super::manifest::Machine::current();
     manifest.merged_from = merged_from;
     manifest.write(out)?;
-    let mut log = RunLog::create(&out_runs)?;
+    // The runs whole or not at all (a full disk leaves no runs, and the merge can be done
+    // again): the manifest alone is a sweep with no runs yet.
     let mut records = Vec::with_capacity(jobs.len());
+    let mut lines = Vec::with_capacity(jobs.len());
     for j in &jobs {
         let (r, line, _) = by_key.remove(&j.key(&spec)).expect("checked: none missing");
-        log.append_line(&line)?;
+        lines.push(line);
         records.push(r);
     }
-    log.sync()?;
+    crate::output::write_atomic(&out_runs, |w| {
+        lines.iter().try_for_each(|line| writeln!(w, "{line}"))
+    })
+    .map_err(|e| ExperimentError::io(&out_runs, e))?;
     summary::write(out, &records)?;
     Ok(Merged {
         records: records.len(),

@@ -117,7 +117,7 @@ pub enum ExperimentError {
     },
     /// Another live process is writing the results directory.
     #[error(
-        "{dir}: another sweep{} is writing there",
+        "{dir}: another sweep, merge or report{} is writing there",
         pid.map_or(String::new(), |p| format!(" (process {p})"))
     )]
     Busy {

@@ -1277,3 +1277,98 @@ fn results_paths_that_cannot_work_are_refused_before_any_run() {
         );
     }
 }
+
+/// A directory's writers take turns: while another process holds `DIR/.lock` (a sweep
+/// writing there), `report DIR` and `merge ... --out DIR` are refused at once (exit 4) and
+/// change nothing; once it is released both go ahead.
+#[test]
+fn report_and_merge_wait_their_turn() {
+    use quadrecomb::internals::experiment::lock::DirLock;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = small_sweep(tmp.path(), "d", &["--shard", "1/2"]);
+    small_sweep(tmp.path(), "e", &["--shard", "2/2"]);
+    std::fs::create_dir(tmp.path().join("m")).unwrap();
+    for (held, args) in [
+        ("d", &["report", "d", "--no-pictures"][..]),
+        ("m", &["merge", "d", "e", "--out", "m"][..]),
+    ] {
+        let lock = DirLock::acquire(&tmp.path().join(held)).unwrap();
+        let before = snapshot(&dir);
+        let o = run_in(tmp.path(), args);
+        assert_eq!(o.status.code(), Some(4), "{args:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("another sweep, merge or report"),
+            "{}",
+            stderr(&o)
+        );
+        // Refused before anything was written.
+        assert!(snapshot(&dir) == before, "{args:?} changed d");
+        let in_m = std::fs::read_dir(tmp.path().join("m")).unwrap();
+        assert!(in_m.map(|e| e.unwrap().file_name()).all(|n| n == ".lock"));
+        drop(lock);
+        let o = run_in(tmp.path(), args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    }
+    assert!(dir.join("report.md").is_file());
+    assert!(tmp.path().join("m/runs.jsonl").is_file());
+}
+
+/// A merge that runs out of space writes its runs whole or not at all: none are left to be
+/// taken for an interrupted sweep, and the same merge done again with room succeeds.
+#[cfg(unix)]
+#[test]
+fn a_merge_that_cannot_write_its_runs_leaves_none() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (name, shard) in [("d", "1/2"), ("e", "2/2")] {
+        let mut args = small_sweep_args(name);
+        args.extend(["--shard", shard, "--no-report"]);
+        let runs = args.iter().position(|&a| a == "--runs").unwrap();
+        args[runs + 1] = "20";
+        let o = run_in(tmp.path(), &args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let runs = std::fs::metadata(tmp.path().join("d/runs.jsonl"))
+        .unwrap()
+        .len()
+        + std::fs::metadata(tmp.path().join("e/runs.jsonl"))
+            .unwrap()
+            .len();
+    // Room for the manifest (a few KiB), not for the runs.
+    let kib = 8;
+    assert!(
+        runs > kib * 1024,
+        "the runs ({runs} B) must not fit in {kib} KiB"
+    );
+    let o = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "trap '' XFSZ; ulimit -f {kib}; exec {} merge d e --out m --no-report",
+            bin().display()
+        ))
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    assert!(!o.status.success(), "the write should have failed");
+    assert!(stderr(&o).contains("File too large"), "{}", stderr(&o));
+    let m = tmp.path().join("m");
+    assert!(
+        !m.join("runs.jsonl").exists(),
+        "a part of the runs was left"
+    );
+    let left: Vec<String> = std::fs::read_dir(&m)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(left.is_empty(), "temporaries left: {left:?}");
+    let o = run_in(
+        tmp.path(),
+        &["merge", "d", "e", "--out", "m", "--no-report"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        lines_of(&m.join("runs.jsonl")).len(),
+        lines_of(&tmp.path().join("d/runs.jsonl")).len()
+            + lines_of(&tmp.path().join("e/runs.jsonl")).len()
+    );
+}
