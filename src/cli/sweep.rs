@@ -241,6 +241,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             (None, [one]) => sweep::mesh_name(one),
             _ => "sweep".to_string(),
         };
+        // A mesh whose stem is dots (a file `...msh`: "..") would name results/.., which is
+        // the working directory: such a mesh's sweep goes where several meshes' go.
+        let base = if base.chars().all(|c| c == '.') {
+            "sweep".to_string()
+        } else {
+            base
+        };
         // Shards get a directory each, so that they never share a run log.
         let name = match args.shard {
             Some(s) => format!("{base}-shard-{}-of-{}", s.index, s.count),

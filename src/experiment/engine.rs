@@ -114,14 +114,13 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
 }
 
 /// Checks that the records of `loaded` (read from `path`/runs.jsonl) are runs of `jobs`
-/// (same keys, mesh hash and size, and seeds when `seeds`), each at most once, with values a
+/// (same keys, seeds, mesh hash and size), each at most once, with values a
 /// run can have ([`check_values`], against the manifest's optimum). Errors give the line.
 pub fn check_records(
     path: &Path,
     manifest: &Manifest,
     jobs: &[Job],
     loaded: &store::Loaded,
-    seeds: bool,
 ) -> Result<HashSet<RunKey>, ExperimentError> {
     let planned: BTreeMap<RunKey, &Job> = jobs.iter().map(|j| (j.key(&manifest.spec), j)).collect();
     let mut seen: BTreeMap<RunKey, usize> = BTreeMap::new();
@@ -138,10 +137,7 @@ pub fn check_records(
             });
         };
         let mesh = &manifest.spec.meshes[job.mesh];
-        if (seeds && r.seed != job.seed)
-            || r.mesh_hash != mesh.hash
-            || r.triangles != mesh.triangles
-        {
+        if r.seed != job.seed || r.mesh_hash != mesh.hash || r.triangles != mesh.triangles {
             return Err(ExperimentError::ForeignRecords {
                 dir: path.to_path_buf(),
                 message: format!(
@@ -271,6 +267,34 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
     if r.recombined_pct > 100.0 + 1e-9 {
         return Err(format!("recombined_pct {} is above 100", r.recombined_pct));
     }
+    // Derived figures are what they derive from (a report shows them as recorded).
+    let pct = percent(2 * r.quads, r.triangles);
+    if !close(r.recombined_pct, pct) {
+        return Err(format!(
+            "recombined_pct {} is not 100 x 2 x {} quads / {} triangles = {pct}",
+            r.recombined_pct, r.quads, r.triangles
+        ));
+    }
+    let branching = match (r.horizon, r.nodes_expanded, r.trees) {
+        (Some(h), Some(nodes), Some(trees)) if h >= 2 && trees > 0 => {
+            effective_branching_factor(nodes as f64 / trees as f64 - 1.0, h - 1)
+        }
+        _ => None,
+    };
+    let same = match (r.branching_factor, branching) {
+        (Some(a), Some(b)) => close(a, b),
+        (a, b) => a.is_none() && b.is_none(),
+    };
+    if !same {
+        return Err(format!(
+            "branching_factor {} is not the one of its {} nodes in {} trees of horizon {} ({})",
+            show(r.branching_factor),
+            show(r.nodes_expanded.map(|n| n as f64)),
+            show(r.trees.map(|n| n as f64)),
+            show(r.horizon.map(f64::from)),
+            show(branching)
+        ));
+    }
     // Sums of eta in different orders differ in the last bits.
     let slack = |q: f64| 1e-9 * q.abs().max(1.0);
     if r.quality > r.quads as f64 + slack(r.quality) {
@@ -288,7 +312,8 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
         let ok = |v: f64| v.is_finite() && (low..=1.0).contains(&v);
         if v.is_some_and(|v| !ok(v)) || (v.is_some() && r.quads == 0) {
             return Err(format!(
-                "{name} {v:?} is not the eta of one of its {} quads under the rule {}",
+                "{name} {} is not the eta of one of its {} quads under the rule {}",
+                show(v),
                 r.quads,
                 r.rule()
             ));
@@ -305,8 +330,8 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
         }
         if r.worst_eta.is_some_and(|w| w > mean + 1e-9) {
             return Err(format!(
-                "worst_eta {:?} is above its mean_eta {mean}",
-                r.worst_eta
+                "worst_eta {} is above its mean_eta {mean}",
+                show(r.worst_eta)
             ));
         }
     }
@@ -322,9 +347,19 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
         ("quads_eta_below_0_1", r.quads_eta_below_0_1),
         ("quads_eta_below_0_3", r.quads_eta_below_0_3),
     ] {
-        if n.is_some_and(|n| n > r.quads) {
-            return Err(format!("{name} {n:?} is more than its {} quads", r.quads));
+        if let Some(n) = n
+            && n > r.quads
+        {
+            return Err(format!("{name} {n} is more than its {} quads", r.quads));
         }
+    }
+    if let (Some(a), Some(b)) = (r.quads_eta_below_0_1, r.quads_eta_below_0_3)
+        && a > b
+    {
+        return Err(format!(
+            "quads_eta_below_0_1 {a} is more than quads_eta_below_0_3 {b} (a quad below 0.1 is \
+             below 0.3)"
+        ));
     }
     if let Some(pct) = r.quality_pct
         && (!pct.is_finite() || pct < 0.0)
@@ -334,14 +369,29 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
         ));
     }
     if let Some(f) = &r.finish {
+        let added = f.triangles_added();
         f.check(r.triangles)?;
-        if let Some(opt) = optimum
-            && f.quads > opt.quads + f.triangles_added()
-        {
+        let pct = percent(2 * f.quads, r.triangles + added);
+        if !close(f.recombined_pct, pct) {
             return Err(format!(
-                "finish: {} quads, more than the {} of its mesh's optimum",
-                f.quads, opt.quads
+                "finish: recombined_pct {} is not 100 x 2 x {} quads / {} triangles = {pct}",
+                f.recombined_pct,
+                f.quads,
+                r.triangles + added
             ));
+        }
+        if let Some(opt) = optimum {
+            if f.quads > opt.quads + added {
+                return Err(format!(
+                    "finish: {} quads, more than the {} of its mesh's optimum",
+                    f.quads, opt.quads
+                ));
+            }
+            // All-quad's splits make another mesh, which the optimum does not bound.
+            if added == 0 {
+                against_optimum(f.quads, f.quality, opt).map_err(|e| format!("finish: {e}"))?;
+            }
+            quality_pct(f.quality_pct, f.quality, opt).map_err(|e| format!("finish: {e}"))?;
         }
     }
     let Some(opt) = optimum else {
@@ -353,18 +403,57 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             r.quads, opt.quads
         ));
     }
-    // The optimum maximises integer weights round(eta * 2^24): a run with as many quads can
-    // beat it by at most half a unit per quad on each side.
-    let rounding = r.quads as f64 / crate::search::optimum::WEIGHT_SCALE;
-    if r.quads == opt.quads && r.quality > opt.quality + rounding + slack(opt.quality) {
+    against_optimum(r.quads, r.quality, opt)?;
+    // The optimum's own record is the optimum the manifest records.
+    if r.algo == "optimum" && (r.quads != opt.quads || !close(r.quality, opt.quality)) {
         return Err(format!(
-            "quality {} is above the exact optimum {} of its mesh, with as many quads",
-            r.quality, opt.quality
+            "the optimum's record ({} quads, quality {}) is not its mesh's recorded optimum \
+             ({} quads, quality {})",
+            r.quads, r.quality, opt.quads, opt.quality
         ));
     }
-    // Present exactly when the optimum is positive: a report compares it across runs, and
-    // falls back to the sum of eta only for a mesh whose runs all lack it.
-    match r.quality_pct {
+    quality_pct(r.quality_pct, r.quality, opt)
+}
+
+/// `100 * part / whole` (0 for an empty whole), as records write percentages.
+fn percent(part: usize, whole: usize) -> f64 {
+    if whole == 0 {
+        0.0
+    } else {
+        100.0 * part as f64 / whole as f64
+    }
+}
+
+/// Whether a recorded figure is the one it derives from, up to the last bits of a sum taken
+/// in another order.
+fn close(recorded: f64, derived: f64) -> bool {
+    (recorded - derived).abs() <= 1e-9 * derived.abs().max(1.0)
+}
+
+/// A value or "none", for messages.
+fn show(v: Option<f64>) -> String {
+    v.map_or("none".into(), |v| v.to_string())
+}
+
+/// A run's quality against its mesh's exact optimum: no run with as many quads beats it.
+fn against_optimum(quads: usize, quality: f64, opt: &OptimumEntry) -> Result<(), String> {
+    // The optimum maximises integer weights round(eta * 2^24): a run with as many quads can
+    // beat it by at most half a unit per quad on each side.
+    let rounding = quads as f64 / crate::search::optimum::WEIGHT_SCALE;
+    if quads == opt.quads && quality > opt.quality + rounding + 1e-9 * opt.quality.abs().max(1.0) {
+        return Err(format!(
+            "quality {quality} is above the exact optimum {} of its mesh, with as many quads",
+            opt.quality
+        ));
+    }
+    Ok(())
+}
+
+/// A recorded quality_pct: present exactly when the optimum is positive (a report compares
+/// it across runs, and falls back to the sum of eta only for a mesh whose runs all lack it),
+/// and then `100 * quality / optimum`.
+fn quality_pct(pct: Option<f64>, quality: f64, opt: &OptimumEntry) -> Result<(), String> {
+    match pct {
         None if opt.quality > 0.0 => Err(format!(
             "quality_pct is missing, but its mesh's optimum {} is recorded",
             opt.quality
@@ -373,10 +462,10 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             "quality_pct {pct} given, but its mesh's optimum is {}",
             opt.quality
         )),
-        Some(pct) if (pct - 100.0 * r.quality / opt.quality).abs() > 1e-6 * pct.abs().max(1.0) => {
+        Some(pct) if (pct - 100.0 * quality / opt.quality).abs() > 1e-6 * pct.abs().max(1.0) => {
             Err(format!(
-                "quality_pct {pct} is not 100 x quality {} / optimum {}",
-                r.quality, opt.quality
+                "quality_pct {pct} is not 100 x quality {quality} / optimum {}",
+                opt.quality
             ))
         }
         _ => Ok(()),
@@ -583,7 +672,7 @@ pub fn run(
             // rewritten: a refused directory keeps its manifest. An extension plans every run
             // of the old list with the same seed (checked above), so they stay valid.
             let old_jobs = shard(plan(&old.spec), old.shard);
-            check_records(dir, &old, &old_jobs, &loaded, true)?;
+            check_records(dir, &old, &old_jobs, &loaded)?;
             if old.spec != manifest.spec {
                 events(Event::Extending {
                     before: old_jobs.len(),
@@ -611,7 +700,7 @@ pub fn run(
     let manifest = &manifest;
 
     let jobs = shard(plan(&manifest.spec), manifest.shard);
-    let done = check_records(dir, manifest, &jobs, &loaded, true)?;
+    let done = check_records(dir, manifest, &jobs, &loaded)?;
     let mut todo: Vec<Job> = jobs
         .iter()
         .filter(|j| !done.contains(&j.key(&manifest.spec)))
@@ -677,7 +766,7 @@ pub(crate) mod tests {
                     mesh: m.name.clone(),
                     mesh_hash: m.hash.clone(),
                     eta_hash: "e".into(),
-                    quality: 20.0,
+                    quality: 4.5,
                     quads: 5,
                     triangles_left: 0,
                     time_s: 0.0,
@@ -918,7 +1007,7 @@ pub(crate) mod tests {
         let out = Outcome {
             quads: 4,
             triangles_left: 2,
-            quality: 15.0,
+            quality: 3.6,
             nodes_expanded: 60,
             trees: 10,
             decisions: 10,
@@ -927,10 +1016,11 @@ pub(crate) mod tests {
             finish: None,
         };
         let r = make_record(&m, &job, out);
-        assert_eq!(r.quality_pct, Some(75.0));
+        // Against the optimum 4.5.
+        assert!((r.quality_pct.unwrap() - 80.0).abs() < 1e-9);
         let checked = RunRecord {
             quality: 3.0,
-            quality_pct: Some(15.0),
+            quality_pct: Some(100.0 * 3.0 / 4.5),
             // The quality per quad.
             mean_eta: Some(0.75),
             ..r.clone()
@@ -953,7 +1043,7 @@ pub(crate) mod tests {
             ..opt.clone()
         };
         let err = check_values(&checked, Some(&zero)).unwrap_err();
-        assert!(err.contains("quality_pct 15 given"), "{err}");
+        assert!(err.contains("quality_pct 66.66"), "{err}");
         assert_eq!(check_values(&missing, Some(&zero)), Ok(()));
     }
 }

@@ -140,7 +140,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
         }
         // Every record must be a run of its part's whole list with the right seed (a shard's
         // records are runs of the whole list too).
-        check_records(p, m, &plan(&m.spec), &loaded, true)?;
+        check_records(p, m, &plan(&m.spec), &loaded)?;
         for (r, line) in loaded.records.iter().zip(&loaded.lines) {
             if let Some((earlier, _, j)) = by_key.get(&r.key()) {
                 // Shards of one configuration are disjoint: a run in two of them means a

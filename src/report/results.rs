@@ -205,8 +205,8 @@ impl Results {
 
 /// Refuses records the report must not believe: with a manifest, a run that is not one of
 /// its sweep's configurations (mesh, algorithm, horizon, run index), of another mesh (hash or
-/// size), or above the recorded optimum; without one, values no run can have; in both, a run
-/// recorded twice. (Seeds are checked where runs are resumed or merged, not here.)
+/// size) or seed, or above the recorded optimum; without one, values no run can have; in
+/// both, a run recorded twice.
 fn check(
     dir: &Path,
     manifest: Option<&manifest::Manifest>,
@@ -215,7 +215,7 @@ fn check(
     use crate::experiment::ExperimentError;
     if let Some(m) = manifest {
         let jobs = crate::experiment::plan::plan(&m.spec);
-        crate::experiment::engine::check_records(dir, m, &jobs, loaded, false)?;
+        crate::experiment::engine::check_records(dir, m, &jobs, loaded)?;
         return Ok(());
     }
     let path = dir.join(store::RUNS_FILE);

@@ -376,6 +376,10 @@ fn report_and_merge_refuse_records_no_run_can_have() {
     let good = lines_of(&runs);
     let n = good.len();
     let optimum_line = good.iter().position(|l| l.contains("\"optimum\"")).unwrap();
+    let h2 = good
+        .iter()
+        .position(|l| l.contains("\"selective\"") && l.contains("\"horizon\":2"))
+        .unwrap();
     let tampered: Vec<(&str, Vec<String>, String)> = vec![
         (
             "recorded twice (first on line 3)",
@@ -458,13 +462,73 @@ fn report_and_merge_refuse_records_no_run_can_have() {
             "line 3".into(),
         ),
         (
-            "worst_eta Some(1.5) is not the eta of one of its",
+            "worst_eta 1.5 is not the eta of one of its",
             {
                 let mut l = good.clone();
                 l[1] = edit_line(&l[1], |v| v["worst_eta"] = 1.5.into());
                 l
             },
             "line 2".into(),
+        ),
+        // Derived figures that do not derive from the run's own (a report shows them as
+        // recorded): all were shown before.
+        (
+            "recombined_pct 50 is not 100 x 2 x",
+            {
+                let mut l = good.clone();
+                l[1] = edit_line(&l[1], |v| v["recombined_pct"] = 50.0.into());
+                l
+            },
+            "line 2".into(),
+        ),
+        (
+            "branching_factor 99 is not the one of its",
+            {
+                let mut l = good.clone();
+                l[h2] = edit_line(&l[h2], |v| v["branching_factor"] = 99.0.into());
+                l
+            },
+            format!("line {}", h2 + 1),
+        ),
+        (
+            "is more than quads_eta_below_0_3",
+            {
+                let mut l = good.clone();
+                l[1] = edit_line(&l[1], |v| {
+                    let b = v["quads_eta_below_0_3"].as_u64().unwrap();
+                    v["quads_eta_below_0_3"] = 0.into();
+                    v["quads_eta_below_0_1"] = b.max(1).into();
+                });
+                l
+            },
+            "line 2".into(),
+        ),
+        (
+            "is not its mesh's recorded optimum",
+            {
+                let mut l = good.clone();
+                let i = optimum_line;
+                l[i] = edit_line(&l[i], |v| {
+                    let q = v["quality"].as_f64().unwrap() * 0.5;
+                    v["quality"] = q.into();
+                    v["quality_pct"] = 50.0.into();
+                    v["mean_eta"] = serde_json::Value::Null;
+                });
+                l
+            },
+            format!("line {}", optimum_line + 1),
+        ),
+        (
+            // Records of another base seed under this manifest (report took them before).
+            "another seed",
+            {
+                let mut l = good.clone();
+                l[h2] = edit_line(&l[h2], |v| {
+                    v["seed"] = (v["seed"].as_u64().unwrap() ^ 1).into();
+                });
+                l
+            },
+            format!("runs.jsonl:{}", h2 + 1),
         ),
     ];
     for (why, lines, at) in tampered {
@@ -489,6 +553,60 @@ fn report_and_merge_refuse_records_no_run_can_have() {
     let o = run_in(tmp.path(), &["report", "d", "--no-pictures"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(std::fs::read(d.join("summary.csv")).unwrap(), summary);
+}
+
+/// A finished run's figures are checked as the search's are: a recombined_pct that is not its
+/// quads' share, a quality above the optimum with as many quads (with a quality_pct to match),
+/// or a quality_pct that is not its quality's share were all shown by `report` before.
+#[test]
+fn report_and_merge_refuse_finish_figures_no_run_can_have() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = small_sweep(tmp.path(), "d", &["--finish", "--no-report"]);
+    let runs = d.join("runs.jsonl");
+    let good = lines_of(&runs);
+    let i = good.iter().position(|l| l.contains("\"finish\"")).unwrap();
+    let finish = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut l = good.clone();
+        l[i] = edit_line(&l[i], |v| f(&mut v["finish"]));
+        l
+    };
+    let opt = {
+        let v: serde_json::Value = serde_json::from_str(&good[i]).unwrap();
+        100.0 * v["quality"].as_f64().unwrap() / v["quality_pct"].as_f64().unwrap()
+    };
+    let tampered: Vec<(&str, Vec<String>)> = vec![
+        (
+            "finish: recombined_pct 5 is not",
+            finish(&|f| f["recombined_pct"] = 5.0.into()),
+        ),
+        (
+            "finish: quality 700 is above the exact optimum",
+            finish(&|f| {
+                f["quality"] = 700.0.into();
+                f["quality_pct"] = (100.0 * 700.0 / opt).into();
+            }),
+        ),
+        (
+            "finish: quality_pct 99 is not 100 x quality",
+            finish(&|f| f["quality_pct"] = 99.0.into()),
+        ),
+    ];
+    for (why, lines) in tampered {
+        std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
+        for cmd in [
+            &["report", "d", "--no-pictures"][..],
+            &["merge", "d", "--out", "m"],
+        ] {
+            let o = run_in(tmp.path(), cmd);
+            let e = stderr(&o);
+            assert_eq!(o.status.code(), Some(3), "{cmd:?} {why}: {e}");
+            let at = format!("line {}", i + 1);
+            assert!(
+                e.contains(why) && e.contains(&at),
+                "{cmd:?} {why} {at}: {e}"
+            );
+        }
+    }
 }
 
 /// Item 6: an optimum cache whose quality was edited (bits included) is not believed: the
@@ -1371,4 +1489,33 @@ fn a_merge_that_cannot_write_its_runs_leaves_none() {
         lines_of(&tmp.path().join("d/runs.jsonl")).len()
             + lines_of(&tmp.path().join("e/runs.jsonl")).len()
     );
+}
+
+/// A mesh file named `...msh` (stem "..") gets the default `--out` of several meshes,
+/// `results/sweep`: `results/..` was the working directory, which the sweep filled.
+#[test]
+fn a_mesh_named_dots_gets_a_results_directory_of_its_own() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run_in(
+        tmp.path(),
+        &["generate", "grid", "--triangles", "60", "-o", "...msh"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run_in(
+        tmp.path(),
+        &[
+            "sweep",
+            "--mesh",
+            "...msh",
+            "--algo",
+            "greedy",
+            "--runs",
+            "1",
+            "-q",
+            "--no-report",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(tmp.path().join("results/sweep/runs.jsonl").is_file());
+    assert!(!tmp.path().join("runs.jsonl").exists());
 }

@@ -12,6 +12,7 @@ use quadrecomb::internals::stats::compare::{
     Magnitude, PMethod, Test, bootstrap_median_diff_ci, compare, holm, mann_whitney, signed_rank,
     vargha_delaney,
 };
+use quadrecomb::internals::stats::describe::effective_branching_factor;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
@@ -231,7 +232,10 @@ pub(crate) fn record(
 ) -> String {
     let triangles = 2104usize;
     let quads = (recombined_pct / 100.0 * triangles as f64 / 2.0).round() as usize;
+    // The figures a record derives are derived as a sweep does (a report checks them).
+    let recombined_pct = 100.0 * 2.0 * quads as f64 / triangles as f64;
     let decisions = quads as u64 + 3;
+    let nodes = decisions * u64::from(horizon.unwrap_or(1)) * 2;
     RunRecord {
         mesh: mesh.to_string(),
         mesh_hash: "0123456789abcdef0123456789abcdef".to_string(),
@@ -248,10 +252,12 @@ pub(crate) fn record(
         quality: quality_pct * 9.5,
         quality_pct: Some(quality_pct),
         time_s,
-        nodes_expanded: Some(decisions * u64::from(horizon.unwrap_or(1)) * 2),
+        nodes_expanded: Some(nodes),
         trees: Some(decisions),
         decisions,
-        branching_factor: horizon.filter(|&h| h >= 2).map(|_| 1.5),
+        branching_factor: horizon
+            .filter(|&h| h >= 2)
+            .and_then(|h| effective_branching_factor(nodes as f64 / decisions as f64 - 1.0, h - 1)),
         worst_eta: Some(0.05),
         mean_eta: Some(quality_pct * 9.5 / quads as f64),
         quads_eta_below_0_1: Some(2),
@@ -444,6 +450,32 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
     }
     .write(dir)
     .unwrap();
+    reseed(dir);
+}
+
+/// Gives the records of `dir/runs.jsonl` (if any) the seeds its manifest's plan gives their
+/// runs (a report checks them), so that fixtures need not derive them.
+fn reseed(dir: &Path) {
+    use quadrecomb::internals::experiment::manifest::Manifest;
+    let m = Manifest::read(dir).unwrap();
+    let seeds: std::collections::BTreeMap<_, _> =
+        quadrecomb::internals::experiment::plan::plan(&m.spec)
+            .iter()
+            .map(|j| (j.key(&m.spec), j.seed))
+            .collect();
+    let path = dir.join("runs.jsonl");
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        return;
+    };
+    let lines: Vec<String> = text
+        .lines()
+        .map(|l| {
+            let mut r: RunRecord = serde_json::from_str(l).unwrap();
+            r.seed = seeds[&r.key()];
+            r.to_json_line()
+        })
+        .collect();
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
 }
 
 /// Parses an SVG through usvg and renders it through resvg; returns the ids of its elements.
@@ -951,6 +983,20 @@ fn real_sphere_dir(dir: &Path, tamper: f64) {
         .unwrap();
     let table = table.restrict(&mesh, quadrecomb::internals::quality::Rule::default());
     let hash = mesh_hash(&mesh);
+    synthetic_manifest(dir, 3);
+    // The manifest's mesh and eta are the real ones.
+    let path = dir.join("manifest.json");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("0123456789abcdef0123456789abcdef", &hash)
+        .replace(
+            "\"eta_hash\": \"e\"",
+            &format!("\"eta_hash\": \"{}\"", eta_hash(&table.eta)),
+        );
+    std::fs::write(&path, text).unwrap();
+    // Runs of three of its configurations, with the seeds its plan gives them.
+    let manifest = quadrecomb::internals::experiment::manifest::Manifest::read(dir).unwrap();
+    let jobs = quadrecomb::internals::experiment::plan::plan(&manifest.spec);
     let mut lines = Vec::new();
     for (algo, h) in [
         ("greedy", None),
@@ -958,7 +1004,11 @@ fn real_sphere_dir(dir: &Path, tamper: f64) {
         ("selective", Some(2)),
     ] {
         for run in 0..3u32 {
-            let seed = SEED + 17 * u64::from(run) + u64::from(h.unwrap_or(0));
+            let seed = jobs
+                .iter()
+                .find(|j| j.algo == algo && j.horizon == h && j.run == run)
+                .unwrap()
+                .seed;
             let out = search::run(
                 &mesh,
                 &table,
@@ -987,7 +1037,12 @@ fn real_sphere_dir(dir: &Path, tamper: f64) {
                     nodes_expanded: Some(out.nodes_expanded),
                     trees: Some(out.trees),
                     decisions: out.decisions,
-                    branching_factor: None,
+                    branching_factor: h.filter(|&h| h >= 2 && out.trees > 0).and_then(|h| {
+                        effective_branching_factor(
+                            out.nodes_expanded as f64 / out.trees as f64 - 1.0,
+                            h - 1,
+                        )
+                    }),
                     worst_eta: None,
                     mean_eta: None,
                     quads_eta_below_0_1: None,
@@ -1003,17 +1058,6 @@ fn real_sphere_dir(dir: &Path, tamper: f64) {
         }
     }
     std::fs::write(dir.join("runs.jsonl"), lines.join("\n") + "\n").unwrap();
-    synthetic_manifest(dir, 3);
-    // The manifest's mesh and eta are the real ones.
-    let path = dir.join("manifest.json");
-    let text = std::fs::read_to_string(&path)
-        .unwrap()
-        .replace("0123456789abcdef0123456789abcdef", &hash)
-        .replace(
-            "\"eta_hash\": \"e\"",
-            &format!("\"eta_hash\": \"{}\"", eta_hash(&table.eta)),
-        );
-    std::fs::write(&path, text).unwrap();
 }
 
 #[test]
