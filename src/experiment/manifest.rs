@@ -312,7 +312,22 @@ impl Manifest {
         let bad_time = (s.time_budgets.iter())
             .chain(s.calibration.iter().map(|c| &c.time_budget_s))
             .find(|t| !t.is_valid());
-        let why = if let Some(t) = bad_time {
+        let why = if s.plan_version == 0 || s.plan_version > super::seed::PLAN_VERSION {
+            Some(format!(
+                "plan version {} is not one this quadrecomb knows (1 to {}): made by a later \
+                 version, or edited",
+                s.plan_version,
+                super::seed::PLAN_VERSION
+            ))
+        } else if s.runs == 0 || s.baseline_runs == 0 {
+            Some(format!(
+                "runs {} and baseline_runs {}: a sweep makes at least one run of each \
+                 configuration",
+                s.runs, s.baseline_runs
+            ))
+        } else if s.horizons.contains(&0) || s.budgets.contains(&0) {
+            Some("a horizon or node budget of 0 (a sweep takes 1 or more)".to_string())
+        } else if let Some(t) = bad_time {
             Some(format!("time budget {} s is out of range", t.seconds()))
         } else if let Some(repeat) = repeated_entry(s) {
             // Jobs are keyed by mesh, algorithm, horizon and budget: a repeat made merge

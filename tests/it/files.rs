@@ -1124,8 +1124,9 @@ fn fuzz_a_huge_time_is_plotted() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
-/// A manifest that lists a horizon, an algorithm or a mesh twice (a sweep refuses each) is
-/// refused by `merge`, `report` and `sweep --resume` with exit 3, naming the repeat (`merge`
+/// A manifest that lists a horizon, an algorithm or a mesh twice (a sweep refuses each), or
+/// holds a plan version this build does not know, no runs or a horizon of 0, is refused by
+/// `merge`, `report` and `sweep --resume` with exit 3, naming what is wrong (`merge`
 /// panicked: "checked: none missing", a review's finding). A `runs.jsonl` or `manifest.json`
 /// that is not a regular file (a directory; a link to a device) is refused with exit 3 by
 /// `merge`, `report` and `--resume` (a directory gave exit 1, a FIFO made them wait forever, and
@@ -1139,7 +1140,7 @@ fn repeated_manifest_entries_and_irregular_files_are_refused() {
     let mut resume = small_sweep_args("d");
     resume.push("--resume");
     type Edit = fn(&mut serde_json::Value);
-    let edits: [(&str, Edit); 3] = [
+    let edits: [(&str, Edit); 6] = [
         ("horizon 2 is listed twice", |m| {
             m["spec"]["horizons"] = serde_json::json!([1, 2, 2])
         }),
@@ -1149,6 +1150,15 @@ fn repeated_manifest_entries_and_irregular_files_are_refused() {
         ("mesh \"sphere\" is listed twice", |m| {
             let mesh = m["spec"]["meshes"][0].clone();
             m["spec"]["meshes"].as_array_mut().unwrap().push(mesh);
+        }),
+        // Blamed on the records before ("run ... is not part of this sweep", "another
+        // seed"), or told to --resume, which a sweep of such a spec cannot.
+        ("plan version 3 is not one this quadrecomb knows", |m| {
+            m["spec"]["plan_version"] = 3.into()
+        }),
+        ("runs 0 and baseline_runs", |m| m["spec"]["runs"] = 0.into()),
+        ("a horizon or node budget of 0", |m| {
+            m["spec"]["horizons"] = serde_json::json!([0, 1, 2])
         }),
     ];
     for (why, edit) in edits {
