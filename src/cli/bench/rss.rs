@@ -26,7 +26,7 @@ pub struct Args {
     )]
     algos: Vec<String>,
     /// Horizon of the tree policies.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
     horizon: u32,
 }
 
@@ -40,10 +40,16 @@ struct Child {
 
 /// Runs `cmd` to its end and returns its status and peak resident set (`wait4`'s rusage).
 #[allow(unsafe_code)] // wait4 and a zeroed rusage: the only way to a child's own peak
-fn run_child(mut cmd: Command) -> std::io::Result<(std::process::ExitStatus, u64, String)> {
+fn run_child(
+    mut cmd: Command,
+    stderr: &Path,
+) -> std::io::Result<(std::process::ExitStatus, u64, String)> {
     use std::io::Read;
     use std::os::unix::process::ExitStatusExt;
-    let mut child = cmd.stdout(Stdio::piped()).stderr(Stdio::null()).spawn()?;
+    // Its stderr goes to a file (a pipe read after stdout could fill and stall it), for the
+    // message of a child that fails.
+    let err = std::fs::File::create(stderr)?;
+    let mut child = cmd.stdout(Stdio::piped()).stderr(err).spawn()?;
     let mut out = String::new();
     if let Some(mut s) = child.stdout.take() {
         s.read_to_string(&mut out)?;
@@ -71,13 +77,25 @@ fn recombine(exe: &Path, mesh: &Path, algo: &str, horizon: u32) -> anyhow::Resul
     if algo == "selective" || algo == "uniform" {
         cmd.args(["--horizon", &horizon.to_string()]);
     }
-    let (status, peak_bytes, out) = run_child(cmd)?;
+    let err_path = mesh.with_extension("stderr.txt");
+    let (status, peak_bytes, out) = run_child(cmd, &err_path)?;
     let time_s = serde_json::from_str::<serde_json::Value>(&out)
         .ok()
         .and_then(|v| v["time_s"].as_f64());
+    // A failed child's last error line (its own message: out of memory, a bad mesh).
+    let said = std::fs::read_to_string(&err_path).ok().and_then(|e| {
+        e.lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .map(String::from)
+    });
+    let _ = std::fs::remove_file(&err_path);
     Ok(Child {
         ok: status.success(),
-        status: status.to_string(),
+        status: match said {
+            Some(said) if !status.success() => format!("{status}: {said}"),
+            _ => status.to_string(),
+        },
         peak_bytes,
         time_s,
     })
@@ -106,8 +124,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     }
     for a in &args.algos {
-        quadrecomb::internals::search::Algo::from_name(a, args.horizon.max(1))
+        quadrecomb::internals::search::Algo::from_name(a, args.horizon)
             .map_err(|e| UsageError(format!("--algos: {e}")))?;
+        if quadrecomb::internals::search::methods::find(a).is_some_and(|m| !m.search) {
+            return Err(UsageError(format!(
+                "--algos: {a} is not a search that `recombine` runs (`bench optimum` measures \
+                 the optimum)"
+            ))
+            .into());
+        }
     }
     if args.max_triangles < 10_000 {
         return Err(UsageError("--max-triangles must be at least 10000".into()).into());
