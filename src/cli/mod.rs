@@ -256,10 +256,24 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), UsageError> {
 /// a symbolic or hard link): the same file by device and inode. Writing it would destroy the
 /// input.
 pub fn check_not_input(output: Option<&std::path::Path>, input: &str) -> Result<(), UsageError> {
+    check_not_same(
+        output,
+        std::path::Path::new(input),
+        &format!("the input mesh {input}"),
+    )
+}
+
+/// Refuses an output that is (after links) the existing file `other`, which it would
+/// overwrite; `what` names `other` in the message.
+pub fn check_not_same(
+    output: Option<&std::path::Path>,
+    other: &std::path::Path,
+    what: &str,
+) -> Result<(), UsageError> {
     let Some(out) = output else {
         return Ok(());
     };
-    let (Ok(a), Ok(b)) = (std::fs::metadata(out), std::fs::metadata(input)) else {
+    let (Ok(a), Ok(b)) = (std::fs::metadata(out), std::fs::metadata(other)) else {
         return Ok(());
     };
     #[cfg(unix)]
@@ -268,11 +282,10 @@ pub fn check_not_input(output: Option<&std::path::Path>, input: &str) -> Result<
         a.dev() == b.dev() && a.ino() == b.ino()
     };
     #[cfg(not(unix))]
-    let same = std::fs::canonicalize(out).ok() == std::fs::canonicalize(input).ok();
+    let same = std::fs::canonicalize(out).ok() == std::fs::canonicalize(other).ok();
     if same {
         return Err(UsageError(format!(
-            "output {} is the input mesh {input}: refusing to overwrite the input; choose \
-             another -o",
+            "output {} is {what}: refusing to overwrite it; choose another -o",
             out.display()
         )));
     }

@@ -151,6 +151,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(file) = replayer.mesh_file(record).map_err(cannot)? {
         super::check_not_input(args.out.output.as_deref(), &file.to_string_lossy())?;
     }
+    // Nor a file of the results directory (through a link, say): its runs or manifest.
+    for name in quadrecomb::internals::experiment::engine::SWEEP_FILES {
+        super::check_not_same(
+            args.out.output.as_deref(),
+            &args.dir.join(name),
+            &format!("{} of the results directory {}", name, args.dir.display()),
+        )?;
+    }
     let out = replayer.replay(record).map_err(cannot)?;
     let write = args.out.output.as_ref().filter(|_| out.reproduced);
     if let Some(path) = write {

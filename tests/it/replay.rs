@@ -225,7 +225,17 @@ fn replay_refuses_what_it_cannot_reproduce() {
 
     // The output may not be the input mesh.
     let o = replay(t, &dir, "0", &r, &["-o", "m.msh"]);
-    refused(&o, 2, "refusing to overwrite the input");
+    refused(&o, 2, "is the input mesh");
+    // Nor a file of the results directory, even through a link (the manifest was replaced
+    // by mesh data).
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(dir.join("manifest.json"), t.join("link.msh")).unwrap();
+        let manifest = std::fs::read(dir.join("manifest.json")).unwrap();
+        let o = replay(t, &dir, "0", &r, &["-o", "link.msh"]);
+        refused(&o, 2, "is manifest.json of the results directory");
+        assert_eq!(std::fs::read(dir.join("manifest.json")).unwrap(), manifest);
+    }
     // Nor a file of another kind; and RUN must be an index of the configuration.
     let o = replay(t, &dir, "0", &r, &["-o", "out.stl"]);
     refused(&o, 2, "expected a .msh or .vtu file name");
