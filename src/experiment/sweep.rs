@@ -201,6 +201,15 @@ pub fn cached_optimum(
         time_s: opt.time_s,
         elements: ElementQuality::of_chosen(table, &opt.chosen),
     };
+    if let Ok(meta) = std::fs::metadata(&dir)
+        && !meta.is_dir()
+    {
+        return Err(ExperimentError::Invalid(format!(
+            "{}: is {}, not the directory of the optimum's cache; remove or move it",
+            dir.display(),
+            crate::mesh::file_kind(&meta)
+        )));
+    }
     std::fs::create_dir_all(&dir).map_err(|e| ExperimentError::io(&dir, e))?;
     let cached = CachedOptimum {
         quality_bits: found.quality.to_bits(),

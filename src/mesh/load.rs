@@ -20,6 +20,16 @@ pub struct Source {
 /// member (`suite:NAME`, [`suite::PREFIX`]).
 pub fn source(spec: &str) -> Result<Source, ReadError> {
     let path = Path::new(spec);
+    if spec.is_empty() {
+        // Named '' in the message, which would otherwise start with a bare colon.
+        return Err(ReadError::Io {
+            path: PathBuf::from("''"),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                "an empty mesh name: give a .msh file or a built-in mesh (borouchaki, sphere)",
+            ),
+        });
+    }
     if !path.exists() {
         match suite::parse_spec(spec) {
             Some(Ok(member)) => {

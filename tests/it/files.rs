@@ -1529,3 +1529,29 @@ fn a_mesh_named_dots_gets_a_results_directory_of_its_own() {
     assert!(tmp.path().join("results/sweep/runs.jsonl").is_file());
     assert!(!tmp.path().join("runs.jsonl").exists());
 }
+
+/// An empty mesh name and an `optimum-cache` that is a file are named for what they are
+/// (before: "loading mesh : : No such file or directory", "optimum-cache: File exists").
+#[test]
+fn an_empty_mesh_name_and_a_cache_that_is_a_file_are_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    for args in [&["info", ""][..], &["recombine", "", "--algo", "greedy"]] {
+        let o = run_in(tmp.path(), args);
+        assert_eq!(o.status.code(), Some(3), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("an empty mesh name"), "{}", stderr(&o));
+    }
+    std::fs::create_dir(tmp.path().join("c")).unwrap();
+    std::fs::write(tmp.path().join("c/optimum-cache"), "").unwrap();
+    let o = run_in(
+        tmp.path(),
+        &[
+            "sweep", "--mesh", "sphere", "--algo", "greedy", "--out", "c", "-q",
+        ],
+    );
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("optimum-cache: is a regular file, not the directory"),
+        "{}",
+        stderr(&o)
+    );
+}
