@@ -766,3 +766,28 @@ fn a_closed_pipe_does_not_cut_a_sweep_short() {
         "the report was written"
     );
 }
+
+/// A benchmark of no repetition has nothing to report: `--repeat 0` ran once and said
+/// "medians of 1 repetitions", `bench finish --runs 0` printed NaN %; `bench rss --horizon 0`
+/// and `--algos optimum` made every child fail with no word of why.
+#[test]
+fn benchmarks_refuse_counts_of_zero() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (args, expect) in [
+        (
+            &["bench", "optimum", "--repeat", "0"][..],
+            "0 is not in 1..",
+        ),
+        (&["bench", "gpu", "--repeat", "0"], "0 is not in 1.."),
+        (&["bench", "suite-eval", "--repeat", "0"], "0 is not in 1.."),
+        (&["bench", "finish", "--runs", "0"], "0 is not in 1.."),
+        (&["bench", "search", "--runs", "0"], "0 is not in 1.."),
+        (&["bench", "rss", "--horizon", "0"], "0 is not in 1.."),
+        (
+            &["bench", "rss", "--algos", "optimum"],
+            "optimum is not a search",
+        ),
+    ] {
+        fails_with(tmp.path(), args, 2, expect);
+    }
+}

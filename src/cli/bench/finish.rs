@@ -21,7 +21,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', default_values_t = [String::from("borouchaki")])]
     meshes: Vec<String>,
     /// Runs (seeds 0..runs) per horizon on each mesh.
-    #[arg(long, default_value_t = 128)]
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u64).range(1..))]
     runs: u64,
     /// Improvement window in rings.
     #[arg(long, default_value_t = finish::DEFAULT_WINDOW)]

@@ -17,7 +17,7 @@ pub struct Args {
           default_value = "1e4,1e5,1e6,1e7")]
     sizes: Vec<usize>,
     /// Timed repetitions per size and backend (the best is reported), after one warm-up.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = super::at_least_one())]
     repeat: usize,
     /// Skip the 1-thread CPU rows (f64 reference and twin) above this many candidates.
     #[arg(long, value_parser = parse_count, default_value = "1e7")]

@@ -51,3 +51,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         What::Rss(a) => rss::run(a),
     }
 }
+
+/// A count flag's parser that refuses 0 (a benchmark of no repetition has nothing to report).
+fn at_least_one() -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::<usize>::new().range(1..)
+}

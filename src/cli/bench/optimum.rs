@@ -23,7 +23,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', default_values_t = ["borouchaki".to_string(), "sphere".to_string()])]
     meshes: Vec<String>,
     /// Timed runs per mesh; the minimum is reported.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = super::at_least_one())]
     repeat: usize,
     /// Skip the peak-memory measurement (one child process per grid size).
     #[arg(long)]

@@ -13,7 +13,7 @@ use std::process::ExitCode;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Seeds per randomized configuration (0, 1, ...); medians are reported.
-    #[arg(long, default_value_t = 9)]
+    #[arg(long, default_value_t = 9, value_parser = clap::value_parser!(u64).range(1..))]
     runs: u64,
     /// Largest generated grid for the per-triangle scaling rows (triangles; the grids are
     /// 10,000, 100,000, ... up to this, so at least 10,000).

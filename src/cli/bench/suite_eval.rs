@@ -16,7 +16,7 @@ pub struct Args {
     #[arg(long, default_value = "default")]
     suite: String,
     /// Timed repetitions of each way (the median is reported, min and max beside it).
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = 7, value_parser = super::at_least_one())]
     repeat: usize,
     /// Skip the device (CPU twin only).
     #[arg(long)]
