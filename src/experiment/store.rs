@@ -72,7 +72,9 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
             serde_json::from_slice(line).map_err(|e| ExperimentError::Corrupt {
                 path: path.to_path_buf(),
                 message: match field_before(line, e.column()) {
-                    Some(field) if e.is_data() => {
+                    // A missing or repeated field is named by serde itself, at the end of
+                    // its object, where the last field before is another.
+                    Some(field) if e.is_data() && !names_its_field(&e) => {
                         format!("line {}: {field}: {}", n + 1, at_column(&e))
                     }
                     _ => format!("line {}: {}", n + 1, at_column(&e)),
@@ -101,6 +103,15 @@ fn at_column(e: &serde_json::Error) -> String {
         Some(head) if e.line() == 1 => format!("{head} at column {}", e.column()),
         _ => text,
     }
+}
+
+/// Whether serde's message names the field itself ("missing field `window`", "duplicate field
+/// `quads`", "unknown field ...").
+fn names_its_field(e: &serde_json::Error) -> bool {
+    let text = e.to_string();
+    ["missing field `", "duplicate field `", "unknown field `"]
+        .iter()
+        .any(|p| text.starts_with(p))
 }
 
 /// The name of the field whose value ends at `column` (1-based, serde_json's position of a
@@ -213,6 +224,30 @@ pub(crate) mod tests {
             version: "0.1.0".into(),
             finish: None,
         }
+    }
+
+    /// A value of the wrong type is named by its field; a missing or repeated field by
+    /// serde's own words, not by the field before the end of the object.
+    #[test]
+    fn errors_name_the_right_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(RUNS_FILE);
+        let line = record(0).to_json_line();
+        let message = |text: String| {
+            std::fs::write(&path, text + "\n").unwrap();
+            match read(&path) {
+                Err(ExperimentError::Corrupt { message, .. }) => message,
+                other => panic!("{other:?}"),
+            }
+        };
+        let m = message(line.replace("\"quads\":48", "\"quads\":\"x\""));
+        assert!(m.starts_with("line 1: field quads: invalid type"), "{m}");
+        let dup = format!("{},\"quads\":3}}", &line[..line.len() - 1]);
+        let m = message(dup);
+        assert!(m.starts_with("line 1: duplicate field `quads`"), "{m}");
+        let missing = line.replace("\"seed\":42,", "");
+        let m = message(missing);
+        assert!(m.starts_with("line 1: missing field `seed`"), "{m}");
     }
 
     #[test]
