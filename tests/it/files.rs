@@ -84,15 +84,12 @@ fn a_report_that_cannot_be_written_leaves_the_earlier_one_whole() {
         "{:?}",
         names(&before)
     );
-    let o = std::process::Command::new("bash")
-        .arg("-c")
-        .arg(format!(
-            "trap '' XFSZ; ulimit -f 10; exec {} report d --no-pictures",
-            bin().display()
-        ))
-        .current_dir(tmp.path())
-        .output()
-        .unwrap();
+    let o = run_limited(
+        tmp.path(),
+        "trap '' XFSZ; ulimit -f 10",
+        &["report", "d", "--no-pictures"],
+        120,
+    );
     assert!(!o.status.success(), "the write should have failed");
     assert!(stderr(&o).contains("File too large"), "{}", stderr(&o));
     let after = snapshot(&dir);
@@ -364,6 +361,22 @@ fn edit_line(line: &str, f: impl FnOnce(&mut serde_json::Value)) -> String {
     serde_json::to_string(&v).unwrap()
 }
 
+/// Writes `lines` as `dir/d/runs.jsonl` and checks that `report d` and `merge d --out m`
+/// refuse them (exit 3) with `why` at `at`, merging nothing.
+fn refused_by_report_and_merge(dir: &Path, lines: &[String], why: &str, at: &str) {
+    std::fs::write(dir.join("d/runs.jsonl"), lines.join("\n") + "\n").unwrap();
+    for cmd in [
+        &["report", "d", "--no-pictures"][..],
+        &["merge", "d", "--out", "m"],
+    ] {
+        let o = run_in(dir, cmd);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(3), "{cmd:?} {why}: {e}");
+        assert!(e.contains(why) && e.contains(at), "{cmd:?} {why} {at}: {e}");
+        assert!(!dir.join("m/runs.jsonl").exists());
+    }
+}
+
 /// Item 6: `report` and `merge` refuse records no run of the sweep can have, naming the
 /// line: a duplicate (83 runs were shown for 64), a configuration the sweep does not hold
 /// (h = 77), another mesh (zero hash), a quality_pct of 150 or a quality above the optimum
@@ -380,6 +393,22 @@ fn report_and_merge_refuse_records_no_run_can_have() {
         .iter()
         .position(|l| l.contains("\"selective\"") && l.contains("\"horizon\":2"))
         .unwrap();
+    // The good lines with line `i` edited by `f`.
+    let edited = |i: usize, f: &dyn Fn(&mut serde_json::Value)| {
+        let mut l = good.clone();
+        l[i] = edit_line(&l[i], f);
+        l
+    };
+    // The optimum's record with its quality (and percentage) scaled by `f`, without the
+    // element figures, which are checked against the quality.
+    let optimum_scaled = |f: f64| {
+        edited(optimum_line, &move |v| {
+            let q = v["quality"].as_f64().unwrap() * f;
+            v["quality"] = q.into();
+            v["quality_pct"] = (100.0 * f).into();
+            v["mean_eta"] = serde_json::Value::Null;
+        })
+    };
     let tampered: Vec<(&str, Vec<String>, String)> = vec![
         (
             "recorded twice (first on line 3)",
@@ -392,160 +421,82 @@ fn report_and_merge_refuse_records_no_run_can_have() {
         ),
         (
             "not part of this sweep",
-            {
-                let mut l = good.clone();
-                l[1] = edit_line(&l[1], |v| v["horizon"] = 77.into());
-                l
-            },
+            edited(1, &|v| v["horizon"] = 77.into()),
             "runs.jsonl:2".into(),
         ),
         (
             "mesh hash",
-            {
-                let mut l = good.clone();
-                l[0] = edit_line(&l[0], |v| v["mesh_hash"] = "0".repeat(64).into());
-                l
-            },
+            edited(0, &|v| v["mesh_hash"] = "0".repeat(64).into()),
             "runs.jsonl:1".into(),
         ),
         (
             "quality_pct 150",
-            {
-                let mut l = good.clone();
-                l[3] = edit_line(&l[3], |v| v["quality_pct"] = 150.0.into());
-                l
-            },
+            edited(3, &|v| v["quality_pct"] = 150.0.into()),
             "line 4".into(),
         ),
         (
             // A percentage beside other runs' raw sums would be compared with them.
             "quality_pct is missing, but its mesh's optimum",
-            {
-                let mut l = good.clone();
-                l[3] = edit_line(&l[3], |v| v["quality_pct"] = serde_json::Value::Null);
-                l
-            },
+            edited(3, &|v| v["quality_pct"] = serde_json::Value::Null),
             "line 4".into(),
         ),
         (
             "above the exact optimum",
-            {
-                let mut l = good.clone();
-                let i = optimum_line;
-                l[i] = edit_line(&l[i], |v| {
-                    let q = v["quality"].as_f64().unwrap() * 1.5;
-                    v["quality"] = q.into();
-                    v["quality_pct"] = 150.0.into();
-                    // Without the element figures, which are checked against the quality.
-                    v["mean_eta"] = serde_json::Value::Null;
-                });
-                l
-            },
+            optimum_scaled(1.5),
             format!("line {}", optimum_line + 1),
         ),
         (
             "was made under the rule",
-            {
-                let mut l = good.clone();
-                l[0] = edit_line(&l[0], |v| v["allow_invalid"] = true.into());
-                l
-            },
+            edited(0, &|v| v["allow_invalid"] = true.into()),
             "runs.jsonl:1".into(),
         ),
         (
             "its rule (min_eta 2, allow_invalid false)",
-            {
-                let mut l = good.clone();
-                l[2] = edit_line(&l[2], |v| v["min_eta"] = 2.0.into());
-                l
-            },
+            edited(2, &|v| v["min_eta"] = 2.0.into()),
             "line 3".into(),
         ),
         (
             "worst_eta 1.5 is not the eta of one of its",
-            {
-                let mut l = good.clone();
-                l[1] = edit_line(&l[1], |v| v["worst_eta"] = 1.5.into());
-                l
-            },
+            edited(1, &|v| v["worst_eta"] = 1.5.into()),
             "line 2".into(),
         ),
         // Derived figures that do not derive from the run's own (a report shows them as
         // recorded): all were shown before.
         (
             "recombined_pct 50 is not 100 x 2 x",
-            {
-                let mut l = good.clone();
-                l[1] = edit_line(&l[1], |v| v["recombined_pct"] = 50.0.into());
-                l
-            },
+            edited(1, &|v| v["recombined_pct"] = 50.0.into()),
             "line 2".into(),
         ),
         (
             "branching_factor 99 is not the one of its",
-            {
-                let mut l = good.clone();
-                l[h2] = edit_line(&l[h2], |v| v["branching_factor"] = 99.0.into());
-                l
-            },
+            edited(h2, &|v| v["branching_factor"] = 99.0.into()),
             format!("line {}", h2 + 1),
         ),
         (
             "is more than quads_eta_below_0_3",
-            {
-                let mut l = good.clone();
-                l[1] = edit_line(&l[1], |v| {
-                    let b = v["quads_eta_below_0_3"].as_u64().unwrap();
-                    v["quads_eta_below_0_3"] = 0.into();
-                    v["quads_eta_below_0_1"] = b.max(1).into();
-                });
-                l
-            },
+            edited(1, &|v| {
+                let b = v["quads_eta_below_0_3"].as_u64().unwrap();
+                v["quads_eta_below_0_3"] = 0.into();
+                v["quads_eta_below_0_1"] = b.max(1).into();
+            }),
             "line 2".into(),
         ),
         (
             "is not its mesh's recorded optimum",
-            {
-                let mut l = good.clone();
-                let i = optimum_line;
-                l[i] = edit_line(&l[i], |v| {
-                    let q = v["quality"].as_f64().unwrap() * 0.5;
-                    v["quality"] = q.into();
-                    v["quality_pct"] = 50.0.into();
-                    v["mean_eta"] = serde_json::Value::Null;
-                });
-                l
-            },
+            optimum_scaled(0.5),
             format!("line {}", optimum_line + 1),
         ),
         (
             // Records of another base seed under this manifest (report took them before).
             "another seed",
-            {
-                let mut l = good.clone();
-                l[h2] = edit_line(&l[h2], |v| {
-                    v["seed"] = (v["seed"].as_u64().unwrap() ^ 1).into();
-                });
-                l
-            },
+            edited(h2, &|v| {
+                v["seed"] = (v["seed"].as_u64().unwrap() ^ 1).into();
+            }),
             format!("runs.jsonl:{}", h2 + 1),
         ),
     ];
     for (why, lines, at) in tampered {
-        std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
-        for cmd in [
-            &["report", "d", "--no-pictures"][..],
-            &["merge", "d", "--out", "m"],
-        ] {
-            let o = run_in(tmp.path(), cmd);
-            let e = stderr(&o);
-            assert_eq!(o.status.code(), Some(3), "{cmd:?} {why}: {e}");
-            assert!(
-                e.contains(why) && e.contains(&at),
-                "{cmd:?} {why} {at}: {e}"
-            );
-            assert!(!tmp.path().join("m/runs.jsonl").exists());
-        }
+        refused_by_report_and_merge(tmp.path(), &lines, why, &at);
     }
     std::fs::write(&runs, good.join("\n") + "\n").unwrap();
     let summary = std::fs::read(d.join("summary.csv")).unwrap();
@@ -592,20 +543,7 @@ fn report_and_merge_refuse_finish_figures_no_run_can_have() {
         ),
     ];
     for (why, lines) in tampered {
-        std::fs::write(&runs, lines.join("\n") + "\n").unwrap();
-        for cmd in [
-            &["report", "d", "--no-pictures"][..],
-            &["merge", "d", "--out", "m"],
-        ] {
-            let o = run_in(tmp.path(), cmd);
-            let e = stderr(&o);
-            assert_eq!(o.status.code(), Some(3), "{cmd:?} {why}: {e}");
-            let at = format!("line {}", i + 1);
-            assert!(
-                e.contains(why) && e.contains(&at),
-                "{cmd:?} {why} {at}: {e}"
-            );
-        }
+        refused_by_report_and_merge(tmp.path(), &lines, why, &format!("line {}", i + 1));
     }
 }
 
@@ -1467,15 +1405,12 @@ fn a_merge_that_cannot_write_its_runs_leaves_none() {
         runs > kib * 1024,
         "the runs ({runs} B) must not fit in {kib} KiB"
     );
-    let o = std::process::Command::new("bash")
-        .arg("-c")
-        .arg(format!(
-            "trap '' XFSZ; ulimit -f {kib}; exec {} merge d e --out m --no-report",
-            bin().display()
-        ))
-        .current_dir(tmp.path())
-        .output()
-        .unwrap();
+    let o = run_limited(
+        tmp.path(),
+        &format!("trap '' XFSZ; ulimit -f {kib}"),
+        &["merge", "d", "e", "--out", "m", "--no-report"],
+        120,
+    );
     assert!(!o.status.success(), "the write should have failed");
     assert!(stderr(&o).contains("File too large"), "{}", stderr(&o));
     let m = tmp.path().join("m");
