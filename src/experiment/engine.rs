@@ -11,10 +11,9 @@ use super::events::{Event, Events};
 use super::exec::{Outcome, WorkerFactory, execute};
 use super::manifest::{MANIFEST_FILE, Manifest, OptimumEntry};
 use super::plan::{Job, execution_order, plan, shard};
-use super::record::{RunKey, RunRecord};
+use super::record::{self, RunKey, RunRecord};
 use super::store::{self, RUNS_FILE, RunLog};
 use super::summary;
-use crate::stats::describe::effective_branching_factor;
 
 /// Options of one execution of a sweep (derived from a
 /// [`SweepConfig`](super::config::SweepConfig) by its `engine_options`).
@@ -61,20 +60,8 @@ impl EngineReport {
 pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
     let mesh = &manifest.spec.meshes[job.mesh];
     let optimum = manifest.optimum.get(job.mesh).map(|o| o.quality);
-    let recombined_pct = if mesh.triangles == 0 {
-        0.0
-    } else {
-        100.0 * 2.0 * out.quads as f64 / mesh.triangles as f64
-    };
-    // A tree of horizon h expands the nodes at depths 0..h-1: 1 + b + ... + b^(h-1) per
-    // tree. Solve for b (the nodes below the root: b + ... + b^(h-1) = N - 1). A tree of
-    // horizon 1 expands only its root, whatever its width: no branching factor.
-    let branching_factor = match job.horizon {
-        Some(h) if h >= 2 && out.trees > 0 => {
-            effective_branching_factor(out.nodes_expanded as f64 / out.trees as f64 - 1.0, h - 1)
-        }
-        _ => None,
-    };
+    let recombined_pct = record::recombined_pct(out.quads, mesh.triangles);
+    let branching_factor = record::branching_factor(job.horizon, out.nodes_expanded, out.trees);
     RunRecord {
         mesh: mesh.name.clone(),
         mesh_hash: mesh.hash.clone(),
@@ -93,8 +80,8 @@ pub fn make_record(manifest: &Manifest, job: &Job, out: Outcome) -> RunRecord {
             .filter(|&o| o > 0.0)
             .map(|o| 100.0 * out.quality / o),
         time_s: out.time_s,
-        nodes_expanded: super::record::builds_trees(&job.algo).then_some(out.nodes_expanded),
-        trees: super::record::builds_trees(&job.algo).then_some(out.trees),
+        nodes_expanded: record::builds_trees(&job.algo).then_some(out.nodes_expanded),
+        trees: record::builds_trees(&job.algo).then_some(out.trees),
         decisions: out.decisions,
         branching_factor,
         worst_eta: out.elements.worst,
@@ -268,17 +255,15 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
         return Err(format!("recombined_pct {} is above 100", r.recombined_pct));
     }
     // Derived figures are what they derive from (a report shows them as recorded).
-    let pct = percent(2 * r.quads, r.triangles);
+    let pct = record::recombined_pct(r.quads, r.triangles);
     if !close(r.recombined_pct, pct) {
         return Err(format!(
             "recombined_pct {} is not 100 x 2 x {} quads / {} triangles = {pct}",
             r.recombined_pct, r.quads, r.triangles
         ));
     }
-    let branching = match (r.horizon, r.nodes_expanded, r.trees) {
-        (Some(h), Some(nodes), Some(trees)) if h >= 2 && trees > 0 => {
-            effective_branching_factor(nodes as f64 / trees as f64 - 1.0, h - 1)
-        }
+    let branching = match (r.nodes_expanded, r.trees) {
+        (Some(nodes), Some(trees)) => record::branching_factor(r.horizon, nodes, trees),
         _ => None,
     };
     let same = match (r.branching_factor, branching) {
@@ -319,22 +304,7 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
             ));
         }
     }
-    // The mean is the quality per quad (both read off the same eta), and no quad is worse
-    // than the worst.
-    if let Some(mean) = r.mean_eta {
-        if (mean * r.quads as f64 - r.quality).abs() > 1e-6 * r.quality.max(1.0) {
-            return Err(format!(
-                "mean_eta {mean} is not its quality {} over its {} quads",
-                r.quality, r.quads
-            ));
-        }
-        if r.worst_eta.is_some_and(|w| w > mean + 1e-9) {
-            return Err(format!(
-                "worst_eta {} is above its mean_eta {mean}",
-                show(r.worst_eta)
-            ));
-        }
-    }
+    mean_and_worst(r.quads, r.quality, r.mean_eta, r.worst_eta)?;
     if let Some(trees) = r.trees
         && trees > r.decisions
     {
@@ -371,7 +341,9 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
     if let Some(f) = &r.finish {
         let added = f.triangles_added();
         f.check(r.triangles)?;
-        let pct = percent(2 * f.quads, r.triangles + added);
+        mean_and_worst(f.quads, f.quality, f.mean_eta, f.worst_eta)
+            .map_err(|e| format!("finish: {e}"))?;
+        let pct = record::recombined_pct(f.quads, r.triangles + added);
         if !close(f.recombined_pct, pct) {
             return Err(format!(
                 "finish: recombined_pct {} is not 100 x 2 x {} quads / {} triangles = {pct}",
@@ -404,30 +376,65 @@ pub fn check_values(r: &RunRecord, optimum: Option<&OptimumEntry>) -> Result<(),
         ));
     }
     against_optimum(r.quads, r.quality, opt)?;
-    // The optimum's own record is the optimum the manifest records.
-    if r.algo == "optimum" && (r.quads != opt.quads || !close(r.quality, opt.quality)) {
+    // The optimum's own record is the optimum the manifest records, element figures
+    // included (older manifests, without them, record none: nothing to compare).
+    let e = &opt.elements;
+    let same_elements = e.mean.is_none()
+        || (r.worst_eta.zip(e.worst).is_some_and(|(a, b)| close(a, b))
+            && r.mean_eta.zip(e.mean).is_some_and(|(a, b)| close(a, b))
+            && r.quads_eta_below_0_1.is_none_or(|n| n == e.below_0_1)
+            && r.quads_eta_below_0_3.is_none_or(|n| n == e.below_0_3));
+    if r.algo == "optimum"
+        && (r.quads != opt.quads || !close(r.quality, opt.quality) || !same_elements)
+    {
         return Err(format!(
-            "the optimum's record ({} quads, quality {}) is not its mesh's recorded optimum \
-             ({} quads, quality {})",
-            r.quads, r.quality, opt.quads, opt.quality
+            "the optimum's record ({} quads, quality {}, worst eta {}, {} and {} quads below \
+             0.1 and 0.3) is not its mesh's recorded optimum ({} quads, quality {}, worst eta \
+             {}, {} and {})",
+            r.quads,
+            r.quality,
+            show(r.worst_eta),
+            r.quads_eta_below_0_1.map_or("?".into(), |n| n.to_string()),
+            r.quads_eta_below_0_3.map_or("?".into(), |n| n.to_string()),
+            opt.quads,
+            opt.quality,
+            show(e.worst),
+            e.below_0_1,
+            e.below_0_3
         ));
     }
     quality_pct(r.quality_pct, r.quality, opt)
-}
-
-/// `100 * part / whole` (0 for an empty whole), as records write percentages.
-fn percent(part: usize, whole: usize) -> f64 {
-    if whole == 0 {
-        0.0
-    } else {
-        100.0 * part as f64 / whole as f64
-    }
 }
 
 /// Whether a recorded figure is the one it derives from, up to the last bits of a sum taken
 /// in another order.
 fn close(recorded: f64, derived: f64) -> bool {
     (recorded - derived).abs() <= 1e-9 * derived.abs().max(1.0)
+}
+
+/// The mean is the quality per quad (both read off the same eta), and no quad is worse than
+/// the worst.
+fn mean_and_worst(
+    quads: usize,
+    quality: f64,
+    mean: Option<f64>,
+    worst: Option<f64>,
+) -> Result<(), String> {
+    let Some(mean) = mean else {
+        return Ok(());
+    };
+    if (mean * quads as f64 - quality).abs() > 1e-6 * quality.max(1.0) {
+        return Err(format!(
+            "mean_eta {mean} is not its quality {quality} over its {quads} quads"
+        ));
+    }
+    if worst.is_some_and(|w| w > mean + 1e-9) {
+        return Err(format!(
+            "worst_eta {} is above its mean_eta {mean}",
+            show(worst)
+        ));
+    }
+    Ok(())
 }
 
 /// A value or "none", for messages.

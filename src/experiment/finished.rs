@@ -220,11 +220,7 @@ impl FinishRecord {
             window: settings.window,
             quads: out.quads,
             triangles_left: out.triangles_left,
-            recombined_pct: if triangles == 0 {
-                0.0
-            } else {
-                100.0 * 2.0 * out.quads as f64 / triangles as f64
-            },
+            recombined_pct: super::record::recombined_pct(out.quads, triangles),
             quality: out.quality,
             quality_pct: optimum
                 .filter(|&o| o > 0.0)

@@ -196,3 +196,27 @@ impl RunRecord {
         serde_json::to_string(self).expect("a RunRecord always serializes")
     }
 }
+
+/// A run's `recombined_pct`: `100 * 2 * quads / triangles` (0 for a mesh without triangles).
+/// The one definition that records are written with and checked against.
+pub fn recombined_pct(quads: usize, triangles: usize) -> f64 {
+    if triangles == 0 {
+        0.0
+    } else {
+        100.0 * 2.0 * quads as f64 / triangles as f64
+    }
+}
+
+/// A run's `branching_factor` from its tree counts. A tree of horizon h expands the nodes at
+/// depths 0..h-1: 1 + b + ... + b^(h-1) per tree; solve for b (the nodes below the root:
+/// b + ... + b^(h-1) = N - 1). A tree of horizon 1 expands only its root, whatever its width:
+/// no branching factor; nor without trees.
+pub fn branching_factor(horizon: Option<u32>, nodes: u64, trees: u64) -> Option<f64> {
+    match horizon {
+        Some(h) if h >= 2 && trees > 0 => crate::stats::describe::effective_branching_factor(
+            nodes as f64 / trees as f64 - 1.0,
+            h - 1,
+        ),
+        _ => None,
+    }
+}

@@ -487,6 +487,12 @@ fn report_and_merge_refuse_records_no_run_can_have() {
             format!("line {}", optimum_line + 1),
         ),
         (
+            // Its element figures too (a second review's edit, accepted before).
+            "is not its mesh's recorded optimum",
+            edited(optimum_line, &|v| v["worst_eta"] = 0.01.into()),
+            format!("line {}", optimum_line + 1),
+        ),
+        (
             // Records of another base seed under this manifest (report took them before).
             "another seed",
             edited(h2, &|v| {
@@ -534,12 +540,18 @@ fn report_and_merge_refuse_finish_figures_no_run_can_have() {
             "finish: quality 700 is above the exact optimum",
             finish(&|f| {
                 f["quality"] = 700.0.into();
+                // Without its mean, which is checked against the quality.
+                f["mean_eta"] = serde_json::Value::Null;
                 f["quality_pct"] = (100.0 * 700.0 / opt).into();
             }),
         ),
         (
             "finish: quality_pct 99 is not 100 x quality",
             finish(&|f| f["quality_pct"] = 99.0.into()),
+        ),
+        (
+            "finish: mean_eta 0.9 is not its quality",
+            finish(&|f| f["mean_eta"] = 0.9.into()),
         ),
     ];
     for (why, lines) in tampered {
