@@ -85,9 +85,10 @@ pub(super) fn box_plots(
                                         Borouchaki mesh."
                         }
                         "uniform" => {
-                            "; the uniform tree branches on every allowed action, so \
-                                      its alpha is of the order of the actions per step, not \
-                                      comparable with the paper's 1.33 for the selective tree."
+                            "; the uniform tree branches on every allowed action (its \
+                                      exact bound cuts the subtrees that cannot hold the best \
+                                      sequence), so its alpha is not comparable with the \
+                                      paper's 1.33 for the selective tree."
                         }
                         _ => ".",
                     });

@@ -174,12 +174,11 @@ pub struct Searcher<'a> {
     trees: u64,
     near: Vec<state::Near>,
     used: Vec<bool>,
-    /// Uniform tree: ranks of the actions allowed at the root; per depth, the ranks the
-    /// path may have allowed.
+    /// Uniform tree: ranks of the actions allowed at the root (no other action is allowed
+    /// anywhere in the tree).
     allowed_ranks: Vec<u32>,
     /// Position in `order` up to which `allowed_ranks` is built.
     allowed_scan: usize,
-    extra: Vec<Vec<u32>>,
     /// Called after each decision of the tree policies, every 2^16 tree nodes and every
     /// 4,096 greedy steps.
     progress: Option<ProgressFn>,
@@ -240,7 +239,6 @@ impl<'a> Searcher<'a> {
             near: Vec::new(),
             allowed_ranks: Vec::new(),
             allowed_scan: 0,
-            extra: Vec::new(),
             used: vec![false; mesh.num_triangles()],
             progress: None,
             started: Instant::now(),

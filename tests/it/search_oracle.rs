@@ -249,6 +249,51 @@ fn oracle_polder_rule_equals_global_rule() {
     }
 }
 
+/// What the uniform tree's bound rests on: along allowed actions, a forbidden action stays
+/// forbidden (proof in docs/search.md, "Forbidden stays forbidden"), in even and odd polders
+/// alike. Random walks to the end on every sample mesh, each verdict from the naive oracle.
+#[test]
+fn oracle_forbidden_actions_stay_forbidden() {
+    let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ 0xF0);
+    // Live forbidden actions seen, in even and in odd polders: the claim was put to the test.
+    let (mut even, mut odd) = (0usize, 0usize);
+    for (name, mesh) in sample_meshes(SEED) {
+        let table = CandidateTable::build(&mesh);
+        for _ in 0..3 {
+            let mut oracle = Naive::new(&mesh, &table);
+            let mut before = oracle.verdicts().allowed;
+            loop {
+                for c in 0..table.len() as u32 {
+                    let [a, b] = oracle.pair(c);
+                    if oracle.is_remaining(a) && oracle.is_remaining(b) && !before[c as usize] {
+                        match oracle.polder(a).len() % 2 {
+                            0 => even += 1,
+                            _ => odd += 1,
+                        }
+                    }
+                }
+                let actions: Vec<u32> = (0..table.len() as u32)
+                    .filter(|&c| before[c as usize])
+                    .collect();
+                if actions.is_empty() {
+                    break;
+                }
+                oracle.apply(actions[rng.random_range(0..actions.len())]);
+                let now = oracle.verdicts().allowed;
+                for c in 0..table.len() {
+                    assert!(
+                        before[c] || !now[c],
+                        "{name}: candidate {c} forbidden before {:?}, allowed after",
+                        oracle.path()
+                    );
+                }
+                before = now;
+            }
+        }
+    }
+    assert!(even > 1000 && odd > 100, "forbidden seen: {even} even, {odd} odd");
+}
+
 #[test]
 fn oracle_sample_meshes_cover_the_cases() {
     let all = sample_meshes(SEED);

@@ -4,7 +4,6 @@
 use super::{HORIZON, Info, Params, Policy};
 use crate::mesh::NONE;
 use crate::search::Searcher;
-use crate::search::policy::BOUND_SLACK;
 
 /// The registry's entry.
 pub static INFO: Info = Info {
@@ -48,13 +47,19 @@ impl Searcher<'_> {
             if self.cursor == self.order.len() {
                 break;
             }
-            // Rewards only fall as triangles are used: the best live eta bounds every step.
-            let top = self.state.table().eta[self.order[self.cursor] as usize];
-            let mut best = f64::NEG_INFINITY;
-            let mut first = NONE;
             self.state.tree_begin();
             self.allowed_ranks.clear();
             self.allowed_scan = self.cursor;
+            // Along allowed actions a forbidden action stays forbidden (docs/search.md,
+            // "Forbidden stays forbidden"): every action of the tree is allowed at its root,
+            // and the best of them bounds every step.
+            let r = self.allowed_rank(0);
+            if r == u32::MAX {
+                break;
+            }
+            let top = self.state.table().eta[self.order[r as usize] as usize];
+            let mut best = f64::NEG_INFINITY;
+            let mut first = NONE;
             self.uniform_dfs(0, h, 0.0, top, NONE, &mut best, &mut first);
             if first == NONE {
                 break;
@@ -84,9 +89,10 @@ impl Searcher<'_> {
         self.allowed_ranks[i]
     }
 
-    /// Explores the node at depth `d` (partial reward `partial`, first action `root`);
-    /// children in decreasing eta, pruned when even `top` per remaining step cannot beat
-    /// `best` (strictly).
+    /// Explores the node at depth `d` (partial reward `partial`, first action `root`):
+    /// the root's allowed actions that are still allowed here, in decreasing eta, pruned when
+    /// even `top` per remaining step cannot beat `best` (strictly: a sequence that only ties
+    /// it would not replace it).
     #[allow(clippy::too_many_arguments)]
     fn uniform_dfs(
         &mut self,
@@ -99,54 +105,21 @@ impl Searcher<'_> {
         first: &mut u32,
     ) {
         let table = self.state.table();
-        let rest = (h - d - 1) as f64 * top;
         let mut any = false;
         let mut cut = false;
         let mut expanded = false;
-        // Ranks to look at, in order: the actions allowed at the root and, below it, the
-        // actions forbidden at the root that the path may have allowed (every other action
-        // reads as at the root: `tree_affected`).
-        let du = d as usize;
-        if self.extra.len() <= du {
-            self.extra.resize_with(du + 1, Vec::new);
-        }
-        let mut extra = std::mem::take(&mut self.extra[du]);
-        extra.clear();
-        if d > 0 {
-            self.state.tree_affected(&mut extra);
-            let (state, rank, cursor) = (&self.state, &self.rank, self.cursor);
-            // An action whose reward cannot beat `best` now never will (`best` only grows,
-            // and the loop below stops at the first such action in eta order): leave it out
-            // before sorting.
-            let floor = *best - partial - rest - BOUND_SLACK;
-            extra.retain(|&c| {
-                table.eta[c as usize] > floor
-                    && !state.is_allowed(c)
-                    && rank[c as usize] as usize >= cursor
-            });
-            extra.iter_mut().for_each(|c| *c = rank[*c as usize]);
-            extra.sort_unstable();
-            extra.dedup();
-        }
-        let (mut i, mut j) = (0, 0);
+        let mut i = 0;
         loop {
-            let a = self.allowed_rank(i);
-            let b = extra.get(j).copied().unwrap_or(u32::MAX);
-            if a == u32::MAX && b == u32::MAX {
+            let r = self.allowed_rank(i);
+            if r == u32::MAX {
                 break;
             }
-            let r = if a < b {
-                i += 1;
-                a
-            } else {
-                j += 1;
-                b
-            };
+            i += 1;
             let c = self.order[r as usize];
             let eta = table.eta[c as usize];
-            // In eta order: once the bound fails it fails for every later action, allowed
-            // or not, so no verdict is needed to stop.
-            if partial + eta + rest + BOUND_SLACK <= *best {
+            // In eta order: once the bound fails it fails for every later action, so no
+            // verdict is needed to stop.
+            if bound_below(partial + eta, h - d - 1, top) <= *best {
                 cut = true;
                 break;
             }
@@ -171,11 +144,21 @@ impl Searcher<'_> {
                 self.state.tree_pop();
             }
         }
-        self.extra[du] = extra;
         if !any && !cut && d > 0 && partial > *best {
             // No action left: a shorter sequence is a leaf.
             *best = partial;
             *first = root;
         }
     }
+}
+
+/// The most that `steps` more rewards, each at most `top`, can add to `sum`, added one after
+/// another as the tree adds them. Rounded addition is monotone in both operands, so no
+/// sequence below comes out above it, not even by a rounding: a subtree whose bound is at
+/// most `best` cannot improve on it (improvement is strict) and is cut, ties included.
+fn bound_below(mut sum: f64, steps: u32, top: f64) -> f64 {
+    for _ in 0..steps {
+        sum += top;
+    }
+    sum
 }
