@@ -291,7 +291,10 @@ fn oracle_forbidden_actions_stay_forbidden() {
             }
         }
     }
-    assert!(even > 1000 && odd > 100, "forbidden seen: {even} even, {odd} odd");
+    assert!(
+        even > 1000 && odd > 100,
+        "forbidden seen: {even} even, {odd} odd"
+    );
 }
 
 #[test]
