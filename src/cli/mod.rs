@@ -36,7 +36,7 @@ mod suite;
 mod sweep;
 mod sweep_progress;
 
-use clap::{CommandFactory, Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 pub use errors::{describe, exit_code};
@@ -74,9 +74,28 @@ enum Command {
     Completions(completions::Args),
 }
 
+/// The command line's parser, where every option's value may be a negative number: `--runs -1`
+/// gets the option's own message ("invalid digit", "must be at least 1") rather than clap's
+/// "unexpected argument '-1'", which reads as a misspelt flag.
+fn command() -> clap::Command {
+    fn negative_values(cmd: clap::Command) -> clap::Command {
+        cmd.mut_args(|a| {
+            if a.get_action().takes_values() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(negative_values)
+    }
+    negative_values(Cli::command())
+}
+
 /// Parses the command line and runs the subcommand.
 pub fn run() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let mut cmd = command();
+    let matches = cmd.get_matches_mut();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.format(&mut cmd).exit());
     match cli.command {
         Command::Info(args) => info::run(args),
         Command::Generate(args) => generate::run(args),
@@ -88,7 +107,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Suite(args) => suite::run(args),
-        Command::Completions(args) => completions::run(args, Cli::command()),
+        Command::Completions(args) => completions::run(args, command()),
     }
 }
 

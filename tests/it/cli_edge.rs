@@ -75,6 +75,39 @@ fn exit_2_usage_error() {
     let mut args = sweep_args("a");
     args.extend(["--threads", "0"]);
     fails_with(tmp.path(), &args, 2, "--threads must be at least 1");
+    // A negative number is a value out of range, not an unknown flag (clap's "unexpected
+    // argument '-1'"), in every command and nested command.
+    for (args, message) in [
+        (
+            &["sweep", "--runs", "-1"][..],
+            "invalid value '-1' for '--runs",
+        ),
+        (
+            &["sweep", "--horizons", "-1"],
+            "invalid value '-1' for '--horizons",
+        ),
+        (
+            &[
+                "recombine",
+                "sphere",
+                "--algo",
+                "selective",
+                "--horizon",
+                "-2",
+            ],
+            "invalid value '-2' for '--horizon",
+        ),
+        (
+            &["generate", "grid", "--triangles", "-5", "-o", "g.msh"],
+            "invalid value '-5' for '--triangles",
+        ),
+        (
+            &["bench", "search", "--runs", "-3"],
+            "invalid value '-3' for '--runs",
+        ),
+    ] {
+        fails_with(tmp.path(), args, 2, message);
+    }
     assert!(!tmp.path().join("a").exists(), "refused before any work");
     // A method's parameter out of range names the flag that carried it.
     fails_with(
