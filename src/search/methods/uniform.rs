@@ -58,6 +58,9 @@ impl Searcher<'_> {
                 break;
             }
             let top = self.state.table().eta[self.order[r as usize] as usize];
+            // Rewards are never negative (eta lies in [0, 1]): a shorter sequence is worth
+            // no more than the bound, and a node cut before its first child hides no leaf.
+            debug_assert!(top >= 0.0, "a negative reward {top}");
             let mut best = f64::NEG_INFINITY;
             let mut first = NONE;
             self.uniform_dfs(0, h, 0.0, top, NONE, &mut best, &mut first);
@@ -155,7 +158,8 @@ impl Searcher<'_> {
 /// The most that `steps` more rewards, each at most `top`, can add to `sum`, added one after
 /// another as the tree adds them. Rounded addition is monotone in both operands, so no
 /// sequence below comes out above it, not even by a rounding: a subtree whose bound is at
-/// most `best` cannot improve on it (improvement is strict) and is cut, ties included.
+/// most `best` cannot improve on it (improvement is strict) and is cut, ties included. With
+/// rewards of at least 0, a sequence that stops early is within the bound too.
 fn bound_below(mut sum: f64, steps: u32, top: f64) -> f64 {
     for _ in 0..steps {
         sum += top;
