@@ -535,7 +535,7 @@ impl State<'_> {
     /// triangles, the candidates at the path's quad vertices, the base verdicts watching a
     /// removed triangle or a merged dead component, and the base split verdicts when a
     /// polder split on the path. Every other live candidate reads as at the root.
-    pub fn tree_affected(&self, out: &mut Vec<u32>) {
+    fn tree_affected(&self, out: &mut Vec<u32>) {
         let tr = &self.tree;
         for &c in &tr.path {
             for x in self.table.pairs[c as usize] {
