@@ -205,9 +205,9 @@ impl std::fmt::Display for Rule {
 /// Settings that make no [`Rule`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RuleError {
-    #[error("the lowest eta must lie in [0, 1], not {0}")]
+    #[error("the lowest eta must lie in [0, 1], not {0:?}")]
     MinEtaRange(f64),
-    #[error("a lowest eta of {0} contradicts allowing invalid quads (which allows every pair)")]
+    #[error("a lowest eta of {0:?} contradicts allowing invalid quads (which allows every pair)")]
     Conflict(f64),
 }
 

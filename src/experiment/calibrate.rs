@@ -71,7 +71,7 @@ pub enum TimeBudgetError {
     Syntax(String),
     /// Not finite, or out of range.
     #[error(
-        "{0} s is not a time budget: it must be a finite number of seconds from {MIN_SECONDS} \
+        "{0:?} s is not a time budget: it must be a finite number of seconds from {MIN_SECONDS} \
          to {MAX_SECONDS} (one day)"
     )]
     Range(f64),
@@ -621,6 +621,13 @@ mod tests {
         for bad in ["", "abc", "5min", "1h"] {
             assert!(matches!(t(bad), Err(TimeBudgetError::Syntax(_))), "{bad}");
         }
+        // Numbers as written, not in long form (1e300 printed 301 digits).
+        assert_eq!(
+            t("1e300").unwrap_err().to_string(),
+            "1e300 s is not a time budget: it must be a finite number of seconds from 0.001 to \
+             86400 (one day)"
+        );
+        assert!(t("1e-9").unwrap_err().to_string().starts_with("1e-9 s "));
         assert_eq!(TimeBudget::new(0.2).unwrap().to_string(), "0.2 s");
         assert_eq!(
             serde_json::to_string(&TimeBudget::new(0.6).unwrap()).unwrap(),

@@ -191,9 +191,19 @@ fn min_eta_raises_the_threshold_and_conflicts_with_allow_invalid() {
         ][..],
         &["optimum", "sphere", "--min-eta", "1.5"],
         &["optimum", "sphere", "--min-eta", "-0.1"],
+        &["optimum", "sphere", "--min-eta", "1e300"],
     ] {
         let out = run_in(tmp.path(), bad);
         assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        // The value as written: 1e300 printed 301 digits.
+        let err = String::from_utf8_lossy(&out.stderr);
+        let value = bad[bad.len() - 1];
+        let value = if value == "--allow-invalid" {
+            "--min-eta"
+        } else {
+            value
+        };
+        assert!(err.contains(value) && err.len() < 300, "{bad:?}: {err}");
     }
 }
 
