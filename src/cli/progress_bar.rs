@@ -4,7 +4,7 @@
 //! ([`Searcher::set_progress`]) and prints nothing.
 
 use indicatif::{ProgressBar, ProgressStyle};
-use quadrecomb::internals::search::{Progress, Searcher};
+use quadrecomb::internals::search::{Params, Progress, Searcher};
 
 /// A run estimated to last longer than this gets a warning.
 const WARN_ABOVE_S: f64 = 60.0;
@@ -21,17 +21,27 @@ pub fn estimate_s(p: &Progress) -> Option<f64> {
     (p.recombined > 0).then(|| p.elapsed_s * p.triangles as f64 / p.recombined as f64)
 }
 
+/// What makes a run faster, ending its [`cost_warning`]: `--horizon` (or `--horizons` in a
+/// sweep) for the tree methods, `--budget(s)` for the budgeted ones, nothing for greedy.
+pub fn faster_hint(params: quadrecomb::internals::search::Params, plural: bool) -> String {
+    let s = if plural { "s" } else { "" };
+    match (params.horizon, params.budget) {
+        (Some(_), _) => format!("; a lower --horizon{s} is faster"),
+        (None, Some(_)) => format!("; a lower --budget{s} is faster"),
+        (None, None) => String::new(),
+    }
+}
+
 /// The warning for a run whose estimated total passes [`WARN_ABOVE_S`], with what the
 /// estimate rests on: the mean tree size and the branching factor it implies over `horizon`
-/// levels (`b^h` nodes per tree).
-pub fn cost_warning(p: &Progress, horizon: Option<u32>) -> Option<String> {
+/// levels (`b^h` nodes per tree); `hint` ends it ([`faster_hint`]).
+pub fn cost_warning(p: &Progress, horizon: Option<u32>, hint: &str) -> Option<String> {
     let Some(total) = estimate_s(p) else {
         // Still in the first tree: its size so far is all there is to go by.
         return (p.nodes > 0 && p.elapsed_s >= ESTIMATE_AFTER_S).then(|| {
             format!(
                 "warning: the first look-ahead tree has expanded {} nodes in {:.1} s and is \
-                 not done; up to {} decisions follow{}: this run will be long; a lower \
-                 --horizon is faster",
+                 not done; up to {} decisions follow{}: this run will be long{hint}",
                 p.nodes,
                 p.elapsed_s,
                 p.triangles / 2,
@@ -64,7 +74,7 @@ pub fn cost_warning(p: &Progress, horizon: Option<u32>) -> Option<String> {
         );
     }
     Some(format!(
-        "warning: this run should take about {} ({why}); a lower --horizon is faster",
+        "warning: this run should take about {} ({why}){hint}",
         duration(total)
     ))
 }
@@ -81,7 +91,8 @@ fn duration(s: f64) -> String {
 
 /// Attaches the warning and the bar to `searcher`'s runs; the returned bar is to be
 /// cleared ([`ProgressBar::finish_and_clear`]) when the run ends.
-pub fn attach(searcher: &mut Searcher<'_>, horizon: Option<u32>) -> ProgressBar {
+pub fn attach(searcher: &mut Searcher<'_>, params: Params) -> ProgressBar {
+    let (horizon, hint) = (params.horizon, faster_hint(params, false));
     let bar = ProgressBar::hidden();
     let shown = bar.clone();
     let mut warned = false;
@@ -92,7 +103,7 @@ pub fn attach(searcher: &mut Searcher<'_>, horizon: Option<u32>) -> ProgressBar 
         // be the larger ones), said once.
         if !warned
             && p.elapsed_s >= ESTIMATE_AFTER_S
-            && let Some(w) = cost_warning(p, horizon)
+            && let Some(w) = cost_warning(p, horizon, &hint)
         {
             warned = true;
             shown.suspend(|| noteln!("{w}"));
@@ -136,29 +147,51 @@ mod tests {
         }
     }
 
+    const H: &str = "; a lower --horizon is faster";
+
+    #[test]
+    fn the_hint_names_the_knob() {
+        let p = |horizon, budget| Params { horizon, budget };
+        assert_eq!(faster_hint(p(Some(3), None), false), H);
+        assert_eq!(
+            faster_hint(p(Some(3), None), true),
+            "; a lower --horizons is faster"
+        );
+        assert_eq!(
+            faster_hint(p(None, Some(64)), true),
+            "; a lower --budgets is faster"
+        );
+        assert_eq!(faster_hint(p(None, None), false), "");
+    }
+
     #[test]
     fn long_runs_are_estimated_and_warned_about() {
         assert_eq!(estimate_s(&at(0, 1.0)), None);
         assert_eq!(estimate_s(&at(20, 1.0)), Some(100.0));
-        assert_eq!(cost_warning(&at(200, 1.0), Some(10)), None, "10 s is fine");
-        let w = cost_warning(&at(20, 1.0), Some(10)).expect("100 s is long");
-        assert!(w.contains("about 100 s"), "{w}");
+        assert_eq!(
+            cost_warning(&at(200, 1.0), Some(10), H),
+            None,
+            "10 s is fine"
+        );
+        let w = cost_warning(&at(20, 1.0), Some(10), H).expect("100 s is long");
+        assert!(w.contains("about 100 s") && w.ends_with(H), "{w}");
         assert!(w.contains("1024 tree nodes per decision"), "{w}");
         // 1024 = 2^10: a branching factor of 2 over 10 levels.
         assert!(
             w.contains("branching factor of about 2.00 over 10 levels"),
             "{w}"
         );
-        let w = cost_warning(&at(2, 10.0), None).expect("10,000 s");
+        let w = cost_warning(&at(2, 10.0), None, "").expect("10,000 s");
         assert!(w.contains("about 2.8 h") && !w.contains("branching"), "{w}");
+        assert!(w.ends_with(')'), "greedy has no knob to lower: {w}");
         // Nothing recombined yet, a tree running for seconds: said too.
-        let w = cost_warning(&at(0, 3.0), Some(100)).expect("a first tree of 3 s");
+        let w = cost_warning(&at(0, 3.0), Some(100), H).expect("a first tree of 3 s");
         assert!(
-            w.contains("first look-ahead tree") && w.contains("horizon 100"),
+            w.contains("first look-ahead tree") && w.contains("horizon 100") && w.ends_with(H),
             "{w}"
         );
         assert_eq!(
-            cost_warning(&at(0, 0.5), Some(100)),
+            cost_warning(&at(0, 0.5), Some(100), H),
             None,
             "too early to tell"
         );

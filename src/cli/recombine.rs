@@ -238,7 +238,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     oom::phase(Phase::Search);
     let mut searcher = search::Searcher::new(&mesh, &table);
-    let bar = super::progress_bar::attach(&mut searcher, horizon_of(algo));
+    let bar = super::progress_bar::attach(&mut searcher, algo.params());
     let out = searcher.run(algo, args.seed);
     bar.finish_and_clear();
     drop(searcher);

@@ -11,8 +11,10 @@ use quadrecomb::internals::experiment::config::{
 };
 use quadrecomb::internals::experiment::events::Event;
 use quadrecomb::internals::experiment::manifest::Shard;
+use quadrecomb::internals::experiment::record::RunKey;
 use quadrecomb::internals::experiment::sweep;
 use quadrecomb::internals::gpu::Backend;
+use quadrecomb::internals::search::{Params, Progress};
 
 use super::UsageError;
 use super::errors::EXIT_INTERRUPTED;
@@ -212,8 +214,137 @@ fn parse_time_budget(s: &str) -> Result<TimeBudget, String> {
         .map_err(|e| format!("bad time budget: {e}"))
 }
 
+/// Warns, once per configuration, of a run that will be long: the estimate and the wording
+/// of `recombine`'s ([`super::progress_bar::cost_warning`]), with the run's key, and what a
+/// Ctrl-C then does. Shown under `-q` too (a warning).
+fn long_run_watch() -> sweep::RunWatch {
+    let warned = std::sync::Mutex::new(std::collections::HashSet::new());
+    std::sync::Arc::new(move |key: &RunKey, p: &Progress| {
+        let params = Params {
+            horizon: key.horizon,
+            budget: key.budget,
+        };
+        let hint = super::progress_bar::faster_hint(params, true);
+        let Some(w) = super::progress_bar::cost_warning(p, key.horizon, &hint) else {
+            return true;
+        };
+        let key = key.to_string();
+        let config = key.rsplit_once(" run ").map_or(key.as_str(), |(c, _)| c);
+        let first = (warned.lock().unwrap_or_else(|e| e.into_inner())).insert(config.to_string());
+        if first {
+            let w = w.strip_prefix("warning: ").unwrap_or(&w);
+            noteln!(
+                "\nwarning: sweep: {key}: {w} (said once per configuration; after a Ctrl-C the \
+                 runs in flight get {GRACE_S} s to finish, then are left to the next --resume)"
+            );
+        }
+        false
+    })
+}
+
 /// Set by Ctrl-C: the sweep stops handing out runs.
 static CANCEL: AtomicBool = AtomicBool::new(false);
+
+/// Seconds the runs in flight get after the first Ctrl-C before the sweep quits without
+/// them: a run is not stopped halfway, and one of a large tree can last hours.
+const GRACE_S: u64 = 10;
+
+/// Where a sweep stands, for one that quits before its runs in flight finish
+/// ([`quit_now`]): set before the runs and by the sweep's events.
+#[derive(Debug)]
+struct Standing {
+    json: bool,
+    out: Option<PathBuf>,
+    shard: Option<String>,
+    /// The flag that finishes the sweep: `--resume` or `--extend`.
+    flag: &'static str,
+    start: Option<std::time::Instant>,
+    /// Runs in this directory's share of the run list, once the runs start.
+    planned: Option<usize>,
+    already: usize,
+    done: usize,
+    /// No run is in flight any more (the sweep ends on its own).
+    finished: bool,
+}
+
+impl Standing {
+    const EMPTY: Standing = Standing {
+        json: false,
+        out: None,
+        shard: None,
+        flag: "--resume",
+        start: None,
+        planned: None,
+        already: 0,
+        done: 0,
+        finished: false,
+    };
+
+    fn event(&mut self, e: &Event<'_>) {
+        match *e {
+            Event::Resuming {
+                recorded, planned, ..
+            } => (self.already, self.planned) = (recorded, Some(planned)),
+            Event::Started { runs } => {
+                self.planned.get_or_insert(self.already + runs as usize);
+            }
+            Event::RunDone => self.done += 1,
+            Event::Finished => self.finished = true,
+            _ => {}
+        }
+    }
+}
+
+fn standing() -> std::sync::MutexGuard<'static, Standing> {
+    static STANDING: std::sync::Mutex<Standing> = std::sync::Mutex::new(Standing::EMPTY);
+    STANDING.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Exits at once (130), keeping every finished run (each record is appended whole as its run
+/// ends; a line torn by the exit is redone by `--resume`): says what is recorded and, with
+/// `--json`, prints the sweep's object as a cancelled sweep does (`backend` and `report`
+/// null: the sweep did not get to them; the summary is written by the next `--resume`).
+fn quit_now(why: &str) -> ! {
+    let s = standing();
+    let out = s.out.clone().unwrap_or_default();
+    if s.json {
+        outln!(
+            "{}",
+            serde_json::json!({
+                "out": out,
+                "runs": s.planned,
+                "new": s.done,
+                "already_recorded": s.planned.map(|_| s.already),
+                "cancelled": true,
+                "shard": s.shard,
+                "backend": null,
+                "files": result_files(&out),
+                "report": null,
+                "time_s": s.start.map(|t| t.elapsed().as_secs_f64()),
+                "phases": null,
+            })
+        );
+    }
+    let shard = s
+        .shard
+        .as_ref()
+        .map(|s| format!(" (shard {s})"))
+        .unwrap_or_default();
+    match s.planned {
+        Some(planned) => noteln!(
+            "\nsweep: {why}: quitting now: {} of {planned} runs recorded in {}{shard}, the runs \
+             in flight not; run the same command with {} to finish",
+            s.already + s.done,
+            out.display(),
+            s.flag
+        ),
+        None => noteln!(
+            "\nsweep: {why}: quitting now, before any run (no run recorded); run the same \
+             command again to start"
+        ),
+    }
+    std::process::exit(i32::from(EXIT_INTERRUPTED));
+}
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     super::oom::phase(super::oom::Phase::Sweep);
@@ -323,25 +454,49 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
     // Ctrl-C, SIGTERM (a batch scheduler's stop, `kill`) and SIGHUP (the terminal closed)
     // stop alike: ctrlc's `termination` feature.
+    *standing() = Standing {
+        json: args.json,
+        out: Some(out.clone()),
+        shard: args.shard.map(|s| s.to_string()),
+        flag: if args.extend { "--extend" } else { "--resume" },
+        start: Some(start),
+        ..Standing::EMPTY
+    };
     ctrlc::set_handler(|| {
         if CANCEL.swap(true, Ordering::SeqCst) {
-            noteln!("\nsweep: interrupted again, exiting now (finished runs are saved)");
-            std::process::exit(i32::from(EXIT_INTERRUPTED));
+            quit_now("interrupted again");
         }
-        noteln!("\nsweep: interrupted: finishing the runs in flight (Ctrl-C or SIGTERM again to quit now)");
+        noteln!(
+            "\nsweep: interrupted: finishing the runs in flight, for up to {GRACE_S} s (Ctrl-C \
+             or SIGTERM again to quit now; runs not finished are redone by the next --resume)"
+        );
+        std::thread::spawn(|| {
+            std::thread::sleep(std::time::Duration::from_secs(GRACE_S));
+            if !standing().finished {
+                quit_now(&format!(
+                    "the runs in flight did not finish within {GRACE_S} s"
+                ));
+            }
+        });
     })
     .context("installing the Ctrl-C / SIGTERM handler")?;
 
     // The searches' wall time: from the engine's start of the runs to their end.
     let (mut runs_start, mut runs_end) = (None, None);
-    let done = sweep::run_timed(&config, &CANCEL, &mut |e| {
-        match e {
-            Event::Started { .. } => runs_start = Some(std::time::Instant::now()),
-            Event::Finished => runs_end = Some(std::time::Instant::now()),
-            _ => {}
-        }
-        display.event(e)
-    });
+    let done = sweep::run_timed(
+        &config,
+        &CANCEL,
+        &mut |e| {
+            match e {
+                Event::Started { .. } => runs_start = Some(std::time::Instant::now()),
+                Event::Finished => runs_end = Some(std::time::Instant::now()),
+                _ => {}
+            }
+            standing().event(&e);
+            display.event(e)
+        },
+        Some(long_run_watch()),
+    );
     let (manifest, report, phases) = match done {
         // Stopped before any run (calibrating): an interruption like one between runs, with
         // nothing recorded and no run list read yet.

@@ -3,6 +3,7 @@
 //! through [`super::engine`] with one reusable [`Searcher`] per thread and mesh.
 
 use std::path::Path;
+use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use super::ExperimentError;
@@ -12,11 +13,20 @@ use super::events::{Event, Events};
 use super::exec::{Outcome, Worker, WorkerFactory};
 use super::manifest::{Machine, Manifest, MeshEntry, OptimumEntry};
 use super::plan::Job;
+use super::record::RunKey;
 use super::seed::{eta_hash, mesh_hash};
 use crate::gpu::Evaluator;
 use crate::mesh::Mesh;
 use crate::quality::{CandidateTable, ElementQuality};
-use crate::search::{Algo, Searcher};
+use crate::search::{Algo, Progress, Searcher};
+
+/// Watches the sweep's runs that last: called from the run's thread with the run's key and
+/// progress about every [`WATCH_PERIOD_S`] once it has lasted that long, until it returns
+/// `false` (the caller warns of a run that will be long; the library prints nothing).
+pub type RunWatch = Arc<dyn Fn(&RunKey, &Progress) -> bool + Send + Sync>;
+
+/// Seconds between two calls of a [`RunWatch`] for one run, and before the first.
+pub const WATCH_PERIOD_S: f64 = 1.0;
 
 /// Directory of the optimum cache inside a results directory.
 pub const OPTIMUM_CACHE_DIR: &str = "optimum-cache";
@@ -264,7 +274,6 @@ impl CachedOptimum {
 }
 
 /// Runs searches (and reports the precomputed optimum) for the engine.
-#[derive(Debug)]
 pub struct SearchFactory<'a> {
     meshes: &'a [Mesh],
     tables: &'a [CandidateTable],
@@ -272,6 +281,18 @@ pub struct SearchFactory<'a> {
     finish: Option<super::finished::FinishSettings>,
     rule: crate::quality::Rule,
     names: Vec<&'a str>,
+    spec: &'a super::manifest::SweepSpec,
+    watch: Option<RunWatch>,
+}
+
+impl std::fmt::Debug for SearchFactory<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SearchFactory")
+            .field("meshes", &self.names)
+            .field("rule", &self.rule)
+            .field("watched", &self.watch.is_some())
+            .finish_non_exhaustive()
+    }
 }
 
 impl<'a> SearchFactory<'a> {
@@ -286,7 +307,14 @@ impl<'a> SearchFactory<'a> {
             names: (prepared.manifest.spec.meshes.iter())
                 .map(|m| m.name.as_str())
                 .collect(),
+            spec: &prepared.manifest.spec,
+            watch: None,
         }
+    }
+
+    /// The factory with `watch` called on its runs that last (see [`RunWatch`]).
+    pub fn watched(self, watch: Option<RunWatch>) -> SearchFactory<'a> {
+        SearchFactory { watch, ..self }
     }
 }
 
@@ -318,6 +346,16 @@ impl Worker for SearchWorker<'_> {
         let f = self.factory;
         let searcher = self.searchers[job.mesh]
             .get_or_insert_with(|| Searcher::new(&f.meshes[job.mesh], &f.tables[job.mesh]));
+        if let Some(watch) = &f.watch {
+            let (watch, key) = (Arc::clone(watch), job.key(f.spec));
+            let (mut next_s, mut watching) = (WATCH_PERIOD_S, true);
+            searcher.set_progress(move |p| {
+                if watching && p.elapsed_s >= next_s {
+                    next_s = p.elapsed_s + WATCH_PERIOD_S;
+                    watching = watch(&key, p);
+                }
+            });
+        }
         let out = searcher.run(algo, job.seed);
         let mut outcome = Outcome::of_run(&out, &f.tables[job.mesh]);
         if let Some(settings) = f.finish {
@@ -376,20 +414,21 @@ pub fn run(
     cancel: &AtomicBool,
     events: &mut Events<'_>,
 ) -> Result<(Manifest, EngineReport), ExperimentError> {
-    run_timed(config, cancel, events).map(|(m, r, _)| (m, r))
+    run_timed(config, cancel, events, None).map(|(m, r, _)| (m, r))
 }
 
-/// [`run`], with the time each phase took.
+/// [`run`], with the time each phase took, and `watch` called on the runs that last.
 pub fn run_timed(
     config: &SweepConfig,
     cancel: &AtomicBool,
     events: &mut Events<'_>,
+    watch: Option<RunWatch>,
 ) -> Result<(Manifest, EngineReport, PhaseTimes), ExperimentError> {
     let mut prepared = prepare(config, events)?;
     if !prepared.manifest.spec.time_budgets.is_empty() {
         prepared.manifest.spec.calibration = calibration(config, &prepared, cancel, events)?;
     }
-    let factory = SearchFactory::new(&prepared);
+    let factory = SearchFactory::new(&prepared).watched(watch);
     let clock = std::time::Instant::now();
     let report = engine::run(
         &prepared.manifest,

@@ -357,6 +357,90 @@ fn interrupted_sweep_keeps_its_runs(signal: &str) {
     assert_eq!(records(&dir.join("int")).len(), total);
 }
 
+/// A run that will last hours is warned about while it runs (a sweep's progress counts
+/// finished runs, and none finishes), and a stop does not wait for it: after SIGTERM the
+/// runs in flight get 10 s, then the sweep quits (130), says what is recorded, and prints
+/// its `--json` object. (A run of the uniform tree of horizon 8 on `sphere`: its first tree
+/// alone is not done after minutes.)
+#[test]
+fn a_long_run_is_warned_about_and_does_not_hold_a_stop() {
+    use std::io::BufRead;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let args = [
+        "sweep",
+        "--mesh",
+        "sphere",
+        "--algo",
+        "uniform",
+        "--horizons",
+        "8",
+        "--out",
+        "long",
+        "--plain",
+        "--json",
+    ];
+    let mut child = Command::new(bin())
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let err = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut all = String::new();
+        for line in std::io::BufReader::new(err).lines().map_while(Result::ok) {
+            if line.starts_with("warning: sweep:") {
+                let _ = tx.send(line.clone());
+            }
+            all += &line;
+            all.push('\n');
+        }
+        all
+    });
+    let warning = rx.recv_timeout(Duration::from_secs(120));
+    let kill = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let stopped = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if stopped.elapsed() > Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("the sweep still ran 60 s after SIGTERM");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let waited = stopped.elapsed();
+    let out = child.wait_with_output().unwrap();
+    let err = reader.join().unwrap();
+    let warning = warning.unwrap_or_else(|_| panic!("no warning within 120 s: {err}"));
+    assert!(
+        warning.contains("sphere uniform h=8 run 0: the first look-ahead tree has expanded")
+            && warning.contains("a lower --horizons is faster"),
+        "{warning}"
+    );
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains(
+            "the runs in flight did not finish within 10 s: quitting now: 0 of 1 runs recorded"
+        ),
+        "{err}"
+    );
+    assert!(
+        waited >= Duration::from_secs(9) && waited < Duration::from_secs(60),
+        "{waited:?}"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["cancelled"], true);
+    assert_eq!((v["runs"].as_u64(), v["new"].as_u64()), (Some(1), Some(0)));
+    let kept = store::read(&dir.join("long/runs.jsonl")).unwrap();
+    assert_eq!((kept.records.len(), kept.torn_bytes), (0, 0));
+}
+
 #[test]
 fn a_second_sweep_into_a_busy_directory_is_refused() {
     let tmp = tempfile::tempdir().unwrap();

@@ -80,7 +80,7 @@ impl Searcher<'_> {
             self.nodes += 1;
             self.trees += 1;
             let quads = self.state.quads();
-            self.tick(quads);
+            self.tick_decision(quads);
             self.state.tree_begin();
             let key = self.rng.next_u64();
             // Children in decreasing reward, so good leaves come first and bound the rest;

@@ -71,7 +71,7 @@ impl Searcher<'_> {
             // One tree per quad (the run's count, set again when it ends).
             self.trees += 1;
             let quads = self.state.quads();
-            self.tick(quads);
+            self.tick_decision(quads);
         }
     }
 
