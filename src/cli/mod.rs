@@ -339,6 +339,11 @@ pub fn write_mesh_output(
     } else {
         Encoding::Binary
     };
+    if let (false, Some(model)) = (vtu, &mesh.model)
+        && let Some(note) = model.not_written_note(mesh)
+    {
+        noteln!("warning: {}: {note}", path.display());
+    }
     quadrecomb::internals::output::write_atomic(path, |mut w| {
         if vtu {
             quadrecomb::internals::mesh::vtu::write_to(&mut w, mesh, rec, encoding)

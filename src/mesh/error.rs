@@ -123,6 +123,24 @@ impl ReadError {
             (b"\x28\xb5\x2f\xfd", "zstd-compressed", "zstd -dc"),
             (b"PK\x03\x04", "a zip archive", "unzip -p"),
         ];
+        let text = head.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(head);
+        let blank = text.iter().take_while(|c| c.is_ascii_whitespace()).count();
+        if let Some(section) = [&b"$NOD"[..], b"$ELM"]
+            .iter()
+            .find(|s| text[blank..].starts_with(s))
+        {
+            // Gmsh's legacy format (MSH 1.0), which Gmsh still reads and meshio does not.
+            return ReadError::Syntax {
+                path: path.to_path_buf(),
+                line: 1 + text[..blank].iter().filter(|&&c| c == b'\n').count(),
+                message: format!(
+                    "this is Gmsh's legacy MSH 1.0 format (`{}`), which quadrecomb does not \
+                     read (it reads versions 2.2 and 4.1): {}",
+                    String::from_utf8_lossy(section),
+                    resave_hint(path)
+                ),
+            };
+        }
         let Some(&(_, what, tool)) = KINDS.iter().find(|k| head.starts_with(k.0)) else {
             return ReadError::UnknownFormat {
                 path: path.to_path_buf(),
@@ -184,6 +202,15 @@ fn flatness(lg: f64) -> String {
             lg.round()
         )
     }
+}
+
+/// How to re-save a Gmsh file of a version quadrecomb does not read (1.0, 3.0, 4.0) as 4.1.
+pub(crate) fn resave_hint(path: &std::path::Path) -> String {
+    format!(
+        "re-save it with Gmsh as version 4.1: `gmsh {} -0 -format msh41 -o {}`",
+        path.display(),
+        path.with_extension("41.msh").display()
+    )
 }
 
 /// How to turn a mesh of another format into a `.msh` quadrecomb reads, naming the tools (Gmsh,

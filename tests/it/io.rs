@@ -609,8 +609,30 @@ fn bad_input_unknown_format_and_version() {
     assert_bad(&empty, &[":1:", "the file is empty"]);
     assert_bad(
         &bad("unsupported_version.msh"),
-        &[":2:", "unsupported MSH version `3.0`"],
+        &[
+            ":2:",
+            "unsupported MSH version `3.0`",
+            "re-save it with Gmsh as version 4.1: `gmsh ",
+            "unsupported_version.msh -0 -format msh41 -o ",
+            "unsupported_version.41.msh`",
+        ],
     );
+    // Gmsh's legacy MSH 1.0 (no $MeshFormat; Gmsh still reads it, meshio does not): named,
+    // with Gmsh's command that re-saves it, not taken for another tool's .msh.
+    let legacy = dir.path().join("legacy.msh");
+    std::fs::write(
+        &legacy,
+        "\n$NOD\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$ENDNOD\n$ELM\n1\n1 2 1 1 3 1 2 3\n$ENDELM\n",
+    )
+    .unwrap();
+    let err = assert_bad(
+        &legacy,
+        &[
+            "legacy.msh:2: this is Gmsh's legacy MSH 1.0 format (`$NOD`)",
+            "-format msh41 -o ",
+        ],
+    );
+    assert!(!err.contains("Fluent"), "{err}");
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! and point and line elements, so that Gmsh can go on from it. Checked through Gmsh's own
 //! Python API (and meshio), not our reader.
 
-use crate::util::{gmsh_available, python, repo_path};
+use crate::util::{gmsh_available, python, repo_path, run_in};
 use quadrecomb::internals::mesh::{self, Mesh, Recombined, msh};
 use quadrecomb::internals::quality::{self, CandidateTable, Rule};
 use quadrecomb::internals::search::{self, Algo};
@@ -961,4 +961,56 @@ fn no_quad_straddles_an_embedded_curve_or_a_seam() {
             }
         }
     }
+}
+
+/// Elements the output cannot hold (a volume's tetrahedra, second-order triangles on one
+/// surface of a first-order mesh) are said when `-o` leaves them out, with the physical
+/// groups left empty: a solver reading our file would otherwise meet an empty group.
+#[test]
+fn elements_left_out_of_the_output_are_warned_about() {
+    let tmp = tempfile::tempdir().unwrap();
+    // A unit square of two triangles (surface 1, group "skin") and a tetrahedron on it
+    // (volume 1, group "vol"), and a 6-node triangle on surface 2 (group "curved").
+    let msh = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n3\n2 1 \"skin\"\n\
+               3 2 \"vol\"\n2 3 \"curved\"\n$EndPhysicalNames\n$Entities\n0 0 2 1\n\
+               1 0 0 0 1 1 0 1 1 0\n2 0 0 0 1 1 0 1 3 0\n1 0 0 0 1 1 1 1 2 1 1\n$EndEntities\n\
+               $Nodes\n2 8 1 8\n2 1 0 7\n1\n2\n3\n4\n6\n7\n8\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n\
+               0.5 0 0\n0.5 0.5 0\n0 0.5 0\n3 1 0 1\n5\n0.5 0.5 1\n$EndNodes\n\
+               $Elements\n3 4 1 4\n2 1 2 2\n1 1 2 3\n2 1 3 4\n3 1 4 1\n3 1 2 3 5\n\
+               2 2 9 1\n4 1 2 4 6 7 8\n$EndElements\n";
+    std::fs::write(tmp.path().join("in.msh"), msh).unwrap();
+    let out = run_in(
+        tmp.path(),
+        &["recombine", "in.msh", "--algo", "greedy", "-o", "out.msh"],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains(
+            "warning: out.msh: the input's 1 Tetrahedron 4 (type 4), 1 Triangle 6 (type 9) are \
+             not written"
+        ) && err.contains(
+            "physical groups left with no element: \"curved\" (dimension 2, tag 3), \"vol\" \
+             (dimension 3, tag 2)"
+        ) && !err.contains("\"skin\""),
+        "{err}"
+    );
+    // Nothing left out (a mesh with groups, points and lines), nothing said.
+    let out = run_in(
+        tmp.path(),
+        &[
+            "recombine",
+            repo_path("tests/data/crack_41_ascii.msh").to_str().unwrap(),
+            "--algo",
+            "greedy",
+            "-o",
+            "again.msh",
+        ],
+    );
+    assert!(out.status.success());
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("not written"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }

@@ -367,19 +367,8 @@ fn a_long_run_is_warned_about_and_does_not_hold_a_stop() {
     use std::io::BufRead;
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let args = [
-        "sweep",
-        "--mesh",
-        "sphere",
-        "--algo",
-        "uniform",
-        "--horizons",
-        "8",
-        "--out",
-        "long",
-        "--plain",
-        "--json",
-    ];
+    let args = "sweep --mesh sphere --algo uniform --horizons 8 --out long --plain --json";
+    let args = args.split_whitespace();
     let mut child = Command::new(bin())
         .args(args)
         .current_dir(dir)

@@ -66,6 +66,11 @@ pub struct Model {
     pub node_param: Vec<Option<[f64; 3]>>,
     /// The point and line elements, in file order.
     pub elements: Vec<Element>,
+    /// The input's elements that a written `.msh` lacks, per type: volume elements, high-order
+    /// and other surface elements that are not read ([`super::SkipReason::Type`], dimension
+    /// 2 and up; points and lines are written back, partition interfaces, ghost cells and
+    /// group copies are not the model's own).
+    pub not_written: Vec<super::SkippedElements>,
 }
 
 impl Model {
@@ -85,6 +90,53 @@ impl Model {
                 }
             }
         }
+    }
+
+    /// What a `.msh` written from `mesh` on this model leaves out, for a warning: the
+    /// elements of [`Model::not_written`] and the physical groups then left with no element,
+    /// or `None` when nothing is left out.
+    pub fn not_written_note(&self, mesh: &crate::mesh::Mesh) -> Option<String> {
+        if self.not_written.is_empty() {
+            return None;
+        }
+        let surfaces: std::collections::BTreeSet<i32> = (mesh.triangle_surface.iter())
+            .chain(&mesh.quad_surface)
+            .copied()
+            .collect();
+        let has_elements = |e: &Entity| match e.dim {
+            0 | 1 => (self.elements.iter()).any(|x| x.dim == e.dim && x.entity == e.tag),
+            2 => surfaces.contains(&e.tag),
+            _ => false,
+        };
+        let mut groups = std::collections::BTreeMap::new();
+        for e in &self.entities {
+            for &p in &e.physicals {
+                *groups.entry((e.dim, p)).or_insert(false) |= has_elements(e);
+            }
+        }
+        let empty: Vec<String> = (groups.into_iter())
+            .filter(|&(_, written)| !written)
+            .map(|((dim, tag), _)| {
+                let name = (self.physical_names.iter())
+                    .find(|n| n.dim == dim && n.tag == tag)
+                    .map_or(String::new(), |n| format!("\"{}\" ", n.name));
+                format!("{name}(dimension {dim}, tag {tag})")
+            })
+            .collect();
+        let what: Vec<String> = self.not_written.iter().map(ToString::to_string).collect();
+        Some(format!(
+            "the input's {} are not written (only the surface mesh is recombined: volume and \
+             high-order elements are not carried over){}",
+            what.join(", "),
+            if empty.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; physical groups left with no element: {}",
+                    empty.join(", ")
+                )
+            }
+        ))
     }
 
     /// The entity of dimension `dim` and tag `tag`, if the model has it.

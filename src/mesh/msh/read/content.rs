@@ -252,6 +252,7 @@ impl ModelParts {
             node_entity: self.node_entity,
             node_param: self.node_param,
             elements: self.elements,
+            not_written: Vec::new(),
         }
     }
 }

@@ -18,7 +18,7 @@ mod parser;
 mod v22;
 mod v41;
 
-use super::{MshFile, MshVersion, SkippedElements};
+use super::{MshFile, MshVersion, SkipReason, SkippedElements};
 use crate::mesh::ReadError;
 use crate::mesh::msh::model::PhysicalName;
 use content::{Content, NodeMap};
@@ -77,8 +77,9 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
             return Err(p.err(
                 vp,
                 format!(
-                    "unsupported MSH version `{}` (quadrecomb reads versions 2.2 and 4.1)",
-                    show(vt)
+                    "unsupported MSH version `{}` (quadrecomb reads versions 2.2 and 4.1): {}",
+                    show(vt),
+                    crate::mesh::error::resave_hint(path)
                 ),
             ));
         }
@@ -224,27 +225,30 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
             }
         }
     }
-    let model = c.model.finish(&c.data);
+    let skipped: Vec<SkippedElements> = (c.skipped.iter())
+        .map(|(&(t, why), &n)| {
+            let (_, dim, name) = element_type(t).expect("skipped types are known");
+            SkippedElements {
+                gmsh_type: t,
+                name,
+                dim,
+                count: n,
+                why,
+            }
+        })
+        .collect();
+    let mut model = c.model.finish(&c.data);
+    model.not_written = (skipped.iter())
+        .filter(|s| s.why == SkipReason::Type && s.dim >= 2)
+        .cloned()
+        .collect();
     c.data.model = Some(Box::new(model));
     Ok(MshFile {
         data: c.data,
         version,
         binary: p.binary,
         ignored_elements: c.skipped.values().sum(),
-        skipped: c
-            .skipped
-            .into_iter()
-            .map(|((t, why), n)| {
-                let (_, dim, name) = element_type(t).expect("skipped types are known");
-                SkippedElements {
-                    gmsh_type: t,
-                    name,
-                    dim,
-                    count: n,
-                    why,
-                }
-            })
-            .collect(),
+        skipped,
     })
 }
 
