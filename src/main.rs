@@ -14,7 +14,15 @@ fn main() -> ExitCode {
     quiet_mesa_device_select();
     ignore_file_size_signal();
     match cli::run() {
-        Ok(code) => code,
+        Ok(code) => match cli::stdout_failure() {
+            // What was printed is incomplete: exit 1 (as for any file the system cannot
+            // write), unless the command failed otherwise.
+            Some(e) if code == ExitCode::SUCCESS => {
+                let _ = writeln!(std::io::stderr(), "error: cannot write to stdout: {e}");
+                ExitCode::from(1)
+            }
+            _ => code,
+        },
         Err(err) => {
             // A closed stderr must not turn the error into a panic: the exit code says it.
             let _ = writeln!(std::io::stderr(), "error: {}", cli::describe(&err));

@@ -171,13 +171,25 @@ impl Rule {
 
     /// Does the rule allow a quad of f64 quality `eta`? Under the valid-quad rule "eta > 0"
     /// means above [`FLAT_ETA`]: a quad whose corner is 180 degrees to within rounding is no
-    /// strictly convex quad.
+    /// strictly convex quad. A pair's quad needs [`Rule::allows_pair`] too.
     #[inline]
     pub fn allows(&self, eta: f64) -> bool {
         match *self {
             Rule::Valid { min_eta } => eta > FLAT_ETA && eta >= min_eta,
             Rule::AllPairs => true,
         }
+    }
+
+    /// Does the rule allow the pair whose quad `[s0, o1, s1, o0]` has f64 quality `eta`
+    /// ([`quad_eta`])? Under the valid-quad rule, besides [`Rule::allows`], every corner must
+    /// turn the way of the quad's own vector area (Newell's normal), as
+    /// [`input_quad_eta`] reads a quad: a non-planar pair can be folded little across its
+    /// diagonal (eta > 0) yet twisted across the other one, and Gmsh reads that quad as
+    /// inverted (negative Jacobian; a review's pair folded 16 degrees across one diagonal and
+    /// 98 across the other, minSICN -0.175). On a planar pair eta > 0 implies it.
+    #[inline]
+    pub fn allows_pair(&self, eta: f64, quad: [[f64; 3]; 4]) -> bool {
+        self.allows(eta) && (self.allows_invalid() || input_quad_eta(quad) > 0.0)
     }
 }
 
@@ -328,7 +340,10 @@ impl CandidateTable {
         let keep: Vec<bool> = self
             .quads
             .iter()
-            .map(|q| rule.allows(quad_eta(q.map(|v| mesh.vertices[v as usize]))))
+            .map(|q| {
+                let p = q.map(|v| mesh.vertices[v as usize]);
+                rule.allows_pair(quad_eta(p), p)
+            })
             .collect();
         self.retain(&keep)
     }
@@ -551,6 +566,38 @@ mod tests {
         ];
         let eta = quad_eta(kite);
         assert!(eta > 1e-4 && rule.allows(eta), "{eta}");
+    }
+
+    /// A review's non-planar pair (two triangles of a Gmsh 2.2 file, nodes 5, 1, 4, 8 around
+    /// the quad, diagonal 5-4): folded about 16 degrees across the diagonal, so eta > 0, but
+    /// 98 degrees across the other one; Gmsh read the quad as inverted (minDetJac -0.00037,
+    /// minSICN -0.175). The valid-quad rule takes no such pair; the paper-literal rule does.
+    #[test]
+    fn a_pair_twisted_across_its_other_diagonal_is_not_valid() {
+        let n5 = [0.63244283, 0.59694155, -0.17357868];
+        let n8 = [0.38724872, 1.13308151, 0.0];
+        let n4 = [0.12380746, 0.43987724, 0.04717726];
+        let n1 = [-0.03541345, 0.13262932, 0.0];
+        for p in [[n5, n1, n4, n8], [n4, n8, n5, n1]] {
+            let eta = quad_eta(p);
+            assert!(eta > 1e-4 && Rule::default().allows(eta), "{eta}");
+            assert_eq!(input_quad_eta(p), 0.0, "a corner turns against the quad");
+            assert!(!Rule::default().allows_pair(eta, p));
+            assert!(Rule::AllPairs.allows_pair(eta, p));
+        }
+        // A planar kite, and the same kite bent 30 degrees across its diagonal, are valid.
+        let kite = [
+            [0.0, 0.0, 0.0],
+            [0.5, -0.5, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.5, 0.8, 0.0],
+        ];
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let mut bent = kite;
+        bent[3] = [0.5, 0.8 * c, 0.8 * s];
+        for p in [kite, bent] {
+            assert!(Rule::default().allows_pair(quad_eta(p), p), "{p:?}");
+        }
     }
 
     #[test]

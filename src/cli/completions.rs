@@ -12,6 +12,13 @@ pub struct Args {
 
 /// Writes the completion script of `cmd` (the whole command line) for `args.shell`.
 pub fn run(args: Args, mut cmd: clap::Command) -> anyhow::Result<ExitCode> {
-    clap_complete::generate(args.shell, &mut cmd, "quadrecomb", &mut std::io::stdout());
+    // Generated into memory first: clap_complete panics when its writer fails (a full disk,
+    // `> /dev/full`); the write's error is then reported as any stdout error is.
+    let mut script = Vec::new();
+    clap_complete::generate(args.shell, &mut cmd, "quadrecomb", &mut script);
+    outln!(
+        "{}",
+        String::from_utf8_lossy(&script).trim_end_matches('\n')
+    );
     Ok(ExitCode::SUCCESS)
 }

@@ -197,10 +197,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             m.triangles.iter().flatten().chain(m.quads.iter().flatten()),
         ),
         candidate_pairs: table.len(),
-        valid_pairs: table
-            .eta
-            .iter()
-            .filter(|&&e| Rule::default().allows(e))
+        valid_pairs: (table.eta.iter().zip(&table.quads))
+            .filter(|&(&e, q)| Rule::default().allows_pair(e, q.map(|v| m.vertices[v as usize])))
             .count(),
         reoriented_triangles: m.reoriented,
         ignored_elements,

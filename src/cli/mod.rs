@@ -2,12 +2,36 @@
 
 /// `println!` that ignores a closed stdout (`quadrecomb ... | head -1`): a reader that
 /// stopped reading must not turn a finished run into a panic (exit 101) or cut a sweep short
-/// before its report. Defined before the submodules so that they all see it.
+/// before its report. Any other failure (a full disk under `> out.json`) is kept for the end:
+/// the command finishes, then says it and exits 1 ([`stdout_failure`]). Defined before the
+/// submodules so that they all see it.
 macro_rules! outln {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
+        if let Err(e) = writeln!(std::io::stdout(), $($arg)*) {
+            $crate::cli::stdout_failed(e);
+        }
     }};
+}
+
+/// The first failure to write stdout other than a closed pipe.
+static STDOUT_FAILURE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+
+/// Keeps `e` unless it is a closed pipe (see `outln!`).
+pub fn stdout_failed(e: std::io::Error) {
+    if e.kind() != std::io::ErrorKind::BrokenPipe {
+        let _ = STDOUT_FAILURE.set(e.to_string());
+    }
+}
+
+/// Flushes stdout and returns the first failure to write it other than a closed pipe: what
+/// the command printed is incomplete, which its exit code must say.
+pub fn stdout_failure() -> Option<String> {
+    use std::io::Write as _;
+    if let Err(e) = std::io::stdout().flush() {
+        stdout_failed(e);
+    }
+    STDOUT_FAILURE.get().cloned()
 }
 
 /// `eprintln!` that ignores a closed stderr (`quadrecomb sweep ... 2>&1 | head -1`), for the

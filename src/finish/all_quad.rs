@@ -116,14 +116,15 @@ pub(crate) fn split(
             }
             continue;
         }
-        let eta = quad_eta(new_table.quads[c].map(|v| new_mesh.vertices[v as usize]));
+        let p = new_table.quads[c].map(|v| new_mesh.vertices[v as usize]);
+        let eta = quad_eta(p);
         new_table.eta[c] = eta;
         // The two halves of one split make a quad with a straight angle: never a pair.
         let halves = b as usize >= nt && split_set.contains(&a) && {
             let k = b as usize - nt;
             splits[k].triangle == a
         };
-        *kept = rule.allows(eta) && !halves;
+        *kept = rule.allows_pair(eta, p) && !halves;
     }
     let new_table = new_table.retain(&keep);
     let mut chosen: Vec<u32> = Vec::new();

@@ -334,9 +334,10 @@ pub(crate) fn refine(
             }
             continue;
         }
-        let eta = quad_eta(new_table.quads[c].map(|v| new_mesh.vertices[v as usize]));
+        let p = new_table.quads[c].map(|v| new_mesh.vertices[v as usize]);
+        let eta = quad_eta(p);
         new_table.eta[c] = eta;
-        *kept = rule.allows(eta);
+        *kept = rule.allows_pair(eta, p);
     }
     let new_table = new_table.retain(&keep);
     let mut chosen: Vec<u32> = Vec::new();

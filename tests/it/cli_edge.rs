@@ -3,8 +3,9 @@
 //! no command-line parser.
 
 use std::path::Path;
+use std::process::{Command, Stdio};
 
-use crate::util::run_in;
+use crate::util::{bin, run_in};
 
 fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
@@ -823,4 +824,58 @@ fn benchmarks_refuse_counts_of_zero() {
     ] {
         fails_with(tmp.path(), args, 2, expect);
     }
+}
+
+/// A stdout that cannot be written (a full disk under `> out.json`; `/dev/full` here) is an
+/// error, exit 1, after the command's work: the JSON or table it meant to print is lost. A
+/// reader that stopped reading (`| head -1`) is not: exit 0. `completions` wrote through
+/// clap_complete, which panicked (exit 101) on such a stdout.
+#[test]
+fn a_stdout_that_cannot_be_written_is_exit_1() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        eprintln!("skipped: no /dev/full on this system");
+        return;
+    };
+    for args in [
+        &[
+            "recombine",
+            "sphere",
+            "--algo",
+            "greedy",
+            "--no-optimum",
+            "--json",
+        ][..],
+        &["optimum", "sphere"],
+        &["suite", "list"],
+        &["completions", "bash"],
+    ] {
+        let out = Command::new(bin())
+            .args(args)
+            .stdout(full.try_clone().unwrap())
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("error: cannot write to stdout: No space left on device")
+                && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+    // A closed pipe: the run is not failed for it.
+    let mut child = Command::new(bin())
+        .args(["completions", "bash"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
