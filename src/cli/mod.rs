@@ -260,6 +260,13 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), UsageError> {
         Err(e) if e.raw_os_error() == Some(libc::ELOOP) => {
             return bad(format!("cannot be written: {e}"));
         }
+        // Looked up, a name longer than the file system takes fails as it would be written.
+        #[cfg(unix)]
+        Err(e) if e.raw_os_error() == Some(libc::ENAMETOOLONG) => {
+            return bad(format!(
+                "the file name is too long for the file system ({e})"
+            ));
+        }
         _ => {}
     }
     // Through a symbolic link that leads to no file, the file the link names is created
@@ -281,11 +288,9 @@ pub fn check_output_place(p: &std::path::Path) -> Result<(), UsageError> {
         Some(d) if !d.exists() => bad(format!("directory {} does not exist{via}", d.display())),
         _ => {
             let d = dir.unwrap_or(std::path::Path::new("."));
-            match tempfile::Builder::new()
-                .prefix(".quadrecomb-")
-                .tempfile_in(d)
-            {
-                Ok(_) => Ok(()),
+            // The temporary file the output is written through, named as it will be.
+            match quadrecomb::internals::output::check_temporary(p) {
+                Ok(()) => Ok(()),
                 Err(e) => bad(format!(
                     "directory {} does not take a new file ({e}){via}; choose another -o",
                     d.display()

@@ -12,6 +12,26 @@ use std::path::{Path, PathBuf};
 
 mod stale;
 
+/// Creates and removes the temporary file [`write_atomic`] would write `path` through (in the
+/// same directory, named after the file): checks before the work that the directory takes it
+/// and that the name is not too long for the file system.
+pub fn check_temporary(path: &Path) -> io::Result<()> {
+    let target = resolve(path);
+    let dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = target
+        .file_name()
+        .unwrap_or_else(|| std::ffi::OsStr::new("output"));
+    let prefix = stale::prefix(name);
+    tempfile::Builder::new()
+        .prefix(&prefix)
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map(drop)
+}
+
 /// Writes the bytes produced by `fill` to `path` atomically.
 ///
 /// A symbolic link at `path` is followed: the file it points to is replaced (or created, when

@@ -59,6 +59,15 @@ fn exit_1_other_failure() {
 #[test]
 fn exit_2_usage_error() {
     let tmp = tempfile::tempdir().unwrap();
+    // An -o name longer than the file system takes is refused before the work (it failed
+    // at the rename, after it: exit 1).
+    let long = format!("{}.msh", "a".repeat(300));
+    fails_with(
+        tmp.path(),
+        &["recombine", "sphere", "--algo", "greedy", "-o", &long],
+        2,
+        "the file name is too long for the file system",
+    );
     fails_with(
         tmp.path(),
         &["sweep", "--no-such-flag"],
