@@ -91,14 +91,25 @@ fn folded(p: [[f64; 3]; 4]) -> bool {
 /// Recombined candidates are read across their diagonal instead ([`quad_eta`]): on a planar
 /// quad both give the same value (both 0 for a pair folded over its diagonal).
 pub fn input_quad_eta(p: [[f64; 3]; 4]) -> f64 {
+    match unit_corners(p) {
+        Some(q) => {
+            eta_from_angles([0, 1, 2, 3].map(|k| angle(q[k], q[(k + 3) % 4], q[(k + 1) % 4])))
+        }
+        None => 0.0,
+    }
+}
+
+/// The quad's corners relative to its centroid, scaled to unit size (so that neither the
+/// products nor the tolerance depend on the coordinates' magnitude), when every corner turns
+/// the way of the quad's vector area (Newell's normal); `None` when one does not (a reflex
+/// corner, a bowtie's lobe, a twisted non-planar quad) or the quad is degenerate.
+fn unit_corners(p: [[f64; 3]; 4]) -> Option<[[f64; 3]; 4]> {
     use crate::mesh::topology::{cross, dot, sub};
-    // Relative to the centroid, scaled to unit size, so that neither the products below nor
-    // the tolerance depend on the coordinates' magnitude.
     let c = [0, 1, 2].map(|k| p.iter().map(|v| v[k]).sum::<f64>() / 4.0);
     let rel = p.map(|v| sub(v, c));
     let m = rel.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
     if m == 0.0 || !m.is_finite() {
-        return 0.0;
+        return None;
     }
     let q = rel.map(|v| v.map(|x| x / m));
     let mut normal = [0.0; 3];
@@ -106,15 +117,12 @@ pub fn input_quad_eta(p: [[f64; 3]; 4]) -> f64 {
         let x = cross(q[k], q[(k + 1) % 4]);
         normal = [normal[0] + x[0], normal[1] + x[1], normal[2] + x[2]];
     }
-    let mut alpha = [0.0; 4];
-    for k in 0..4 {
-        let (prev, here, next) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
-        if dot(cross(sub(here, prev), sub(next, here)), normal) <= 0.0 {
-            return 0.0;
-        }
-        alpha[k] = angle(here, prev, next);
-    }
-    eta_from_angles(alpha)
+    (0..4)
+        .all(|k| {
+            let (prev, here, next) = (q[(k + 3) % 4], q[k], q[(k + 1) % 4]);
+            dot(cross(sub(here, prev), sub(next, here)), normal) > 0.0
+        })
+        .then_some(q)
 }
 
 /// Which pairs of neighbouring triangles may be merged: the actions of every policy and the
@@ -189,7 +197,7 @@ impl Rule {
     /// 98 across the other, minSICN -0.175). On a planar pair eta > 0 implies it.
     #[inline]
     pub fn allows_pair(&self, eta: f64, quad: [[f64; 3]; 4]) -> bool {
-        self.allows(eta) && (self.allows_invalid() || input_quad_eta(quad) > 0.0)
+        self.allows(eta) && (self.allows_invalid() || unit_corners(quad).is_some())
     }
 }
 
