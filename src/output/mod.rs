@@ -17,6 +17,17 @@ mod stale;
 /// and that the name is not too long for the file system.
 pub fn check_temporary(path: &Path) -> io::Result<()> {
     let target = resolve(path);
+    let (dir, name) = dir_and_name(&target);
+    let prefix = stale::prefix(name);
+    tempfile::Builder::new()
+        .prefix(&prefix)
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map(drop)
+}
+
+/// The directory `target` is in (`.` for a bare name) and its file name.
+fn dir_and_name(target: &Path) -> (&Path, &std::ffi::OsStr) {
     let dir = match target.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -24,12 +35,7 @@ pub fn check_temporary(path: &Path) -> io::Result<()> {
     let name = target
         .file_name()
         .unwrap_or_else(|| std::ffi::OsStr::new("output"));
-    let prefix = stale::prefix(name);
-    tempfile::Builder::new()
-        .prefix(&prefix)
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map(drop)
+    (dir, name)
 }
 
 /// Writes the bytes produced by `fill` to `path` atomically.
@@ -58,13 +64,7 @@ pub fn write_atomic(
         Err(e) if e.kind() == io::ErrorKind::NotFound => None,
         Err(e) => return Err(e),
     };
-    let dir = match target.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let name = target
-        .file_name()
-        .unwrap_or_else(|| std::ffi::OsStr::new("output"));
+    let (dir, name) = dir_and_name(&target);
     stale::remove_stale(dir, name);
     let prefix = stale::prefix(name);
     let mut builder = tempfile::Builder::new();
