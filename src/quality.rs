@@ -199,6 +199,11 @@ impl Rule {
     pub fn allows_pair(&self, eta: f64, quad: [[f64; 3]; 4]) -> bool {
         self.allows(eta) && (self.allows_invalid() || unit_corners(quad).is_some())
     }
+
+    /// [`Rule::allows_pair`] with the quad's eta computed here.
+    pub fn allows_quad(&self, quad: [[f64; 3]; 4]) -> bool {
+        self.allows_pair(quad_eta(quad), quad)
+    }
 }
 
 /// eta at or below which a quad is flat to within rounding: a corner of 180 degrees (a node
@@ -348,10 +353,7 @@ impl CandidateTable {
         let keep: Vec<bool> = self
             .quads
             .iter()
-            .map(|q| {
-                let p = q.map(|v| mesh.vertices[v as usize]);
-                rule.allows_pair(quad_eta(p), p)
-            })
+            .map(|q| rule.allows_quad(q.map(|v| mesh.vertices[v as usize])))
             .collect();
         self.retain(&keep)
     }

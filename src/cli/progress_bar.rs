@@ -23,7 +23,7 @@ pub fn estimate_s(p: &Progress) -> Option<f64> {
 
 /// What makes a run faster, ending its [`cost_warning`]: `--horizon` (or `--horizons` in a
 /// sweep) for the tree methods, `--budget(s)` for the budgeted ones, nothing for greedy.
-pub fn faster_hint(params: quadrecomb::internals::search::Params, plural: bool) -> String {
+pub fn faster_hint(params: Params, plural: bool) -> String {
     let s = if plural { "s" } else { "" };
     match (params.horizon, params.budget) {
         (Some(_), _) => format!("; a lower --horizon{s} is faster"),

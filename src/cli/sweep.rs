@@ -228,9 +228,11 @@ fn long_run_watch() -> sweep::RunWatch {
         let Some(w) = super::progress_bar::cost_warning(p, key.horizon, &hint) else {
             return true;
         };
-        let key = key.to_string();
-        let config = key.rsplit_once(" run ").map_or(key.as_str(), |(c, _)| c);
-        let first = (warned.lock().unwrap_or_else(|e| e.into_inner())).insert(config.to_string());
+        let config = RunKey {
+            run: 0,
+            ..key.clone()
+        };
+        let first = (warned.lock().unwrap_or_else(|e| e.into_inner())).insert(config);
         if first {
             let w = w.strip_prefix("warning: ").unwrap_or(&w);
             noteln!(

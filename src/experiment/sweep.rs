@@ -280,7 +280,6 @@ pub struct SearchFactory<'a> {
     optimum: &'a [OptimumEntry],
     finish: Option<super::finished::FinishSettings>,
     rule: crate::quality::Rule,
-    names: Vec<&'a str>,
     spec: &'a super::manifest::SweepSpec,
     watch: Option<RunWatch>,
 }
@@ -288,7 +287,7 @@ pub struct SearchFactory<'a> {
 impl std::fmt::Debug for SearchFactory<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SearchFactory")
-            .field("meshes", &self.names)
+            .field("meshes", &self.spec.meshes.len())
             .field("rule", &self.rule)
             .field("watched", &self.watch.is_some())
             .finish_non_exhaustive()
@@ -304,9 +303,6 @@ impl<'a> SearchFactory<'a> {
             optimum: &prepared.manifest.optimum,
             finish: prepared.manifest.spec.finish,
             rule: prepared.manifest.spec.rule(),
-            names: (prepared.manifest.spec.meshes.iter())
-                .map(|m| m.name.as_str())
-                .collect(),
             spec: &prepared.manifest.spec,
             watch: None,
         }
@@ -363,7 +359,7 @@ impl Worker for SearchWorker<'_> {
             outcome.finish = Some(
                 super::finished::finish_run(mesh, table, &out.chosen, settings, f.rule).map_err(
                     |source| ExperimentError::Finish {
-                        mesh: f.names[job.mesh].to_string(),
+                        mesh: f.spec.meshes[job.mesh].name.clone(),
                         seed: job.seed,
                         source,
                     },

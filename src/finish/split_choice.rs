@@ -23,7 +23,7 @@
 
 use super::region::{Accept, Pairing, RegionSolver, Rings};
 use crate::mesh::{Mesh, NONE};
-use crate::quality::{CandidateTable, Rule, quad_eta};
+use crate::quality::{CandidateTable, Rule};
 use std::collections::{BTreeMap, VecDeque};
 
 /// A split chosen: the triangle, the index of its boundary side, its distance from the
@@ -155,9 +155,13 @@ pub(crate) fn split_side(
         let m: [f64; 3] = std::array::from_fn(|d| 0.5 * (pp[d] + pq[d]));
         let (o_qo, o_op) = (across((i + 1) % 3)?, across((i + 2) % 3)?);
         // Half (p, m, o) with the triangle across o-p; half (m, q, o) across q-o.
-        let first = quad_eta([at(o), at(o_op), pp, m]);
-        let second = quad_eta([pq, at(o_qo), at(o), m]);
-        (rule.allows(first) && rule.allows(second)).then_some((i, nb[(i + 2) % 3], nb[(i + 1) % 3]))
+        let first = [at(o), at(o_op), pp, m];
+        let second = [pq, at(o_qo), at(o), m];
+        (rule.allows_quad(first) && rule.allows_quad(second)).then_some((
+            i,
+            nb[(i + 2) % 3],
+            nb[(i + 1) % 3],
+        ))
     })
 }
 
