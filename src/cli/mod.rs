@@ -100,7 +100,8 @@ enum Command {
 
 /// The command line's parser, where every option's value may be a negative number: `--runs -1`
 /// gets the option's own message ("invalid digit", "must be at least 1") rather than clap's
-/// "unexpected argument '-1'", which reads as a misspelt flag.
+/// "unexpected argument '-1'", which reads as a misspelt flag (numbers clap does not know as
+/// numbers: [`join_negative_numbers`]).
 fn command() -> clap::Command {
     fn negative_values(cmd: clap::Command) -> clap::Command {
         cmd.mut_args(|a| {
@@ -115,10 +116,62 @@ fn command() -> clap::Command {
     negative_values(Cli::command())
 }
 
+/// `args` with a negative number after a long option that takes a value joined to it
+/// (`--min-eta -1e-300` becomes `--min-eta=-1e-300`): clap reads `-1` and `-0.5` as
+/// numbers but `-1e-300`, `-.5` and `-inf` as flags ("unexpected argument '-1'"). Only
+/// tokens that parse as numbers are joined, and only after an option of the subcommand at
+/// hand that takes values, so a missing value before a flag is still reported as one.
+fn join_negative_numbers(
+    cmd: &clap::Command,
+    args: impl IntoIterator<Item = std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    let mut out = Vec::new();
+    let mut cur = cmd;
+    let mut args = args.into_iter().peekable();
+    if let Some(program) = args.next() {
+        out.push(program);
+    }
+    while let Some(arg) = args.next() {
+        let Some(text) = arg.to_str() else {
+            out.push(arg);
+            continue;
+        };
+        if text == "--" {
+            out.push(arg);
+            out.extend(args);
+            break;
+        }
+        if let Some(name) = text.strip_prefix("--").filter(|n| !n.contains('=')) {
+            let takes_value = cur
+                .get_arguments()
+                .any(|a| a.get_long() == Some(name) && a.get_action().takes_values());
+            let number = args
+                .peek()
+                .and_then(|next| next.to_str())
+                .filter(|next| next.starts_with('-') && next.parse::<f64>().is_ok())
+                .map(str::to_owned);
+            if let (true, Some(number)) = (takes_value, number) {
+                args.next();
+                out.push(format!("{text}={number}").into());
+                continue;
+            }
+        } else if !text.starts_with('-')
+            && let Some(sub) = cur.find_subcommand(text)
+        {
+            cur = sub;
+        }
+        out.push(arg);
+    }
+    out
+}
+
 /// Parses the command line and runs the subcommand.
 pub fn run() -> anyhow::Result<ExitCode> {
     let mut cmd = command();
-    let matches = cmd.get_matches_mut();
+    let args = join_negative_numbers(&cmd, std::env::args_os());
+    let matches = cmd
+        .try_get_matches_from_mut(args)
+        .unwrap_or_else(|e| e.exit());
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.format(&mut cmd).exit());
     match cli.command {
         Command::Info(args) => info::run(args),

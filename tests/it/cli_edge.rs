@@ -115,6 +115,31 @@ fn exit_2_usage_error() {
             &["bench", "search", "--runs", "-3"],
             "invalid value '-3' for '--runs",
         ),
+        // Numbers clap does not know as numbers: an exponent's sign, no leading digit.
+        (
+            &[
+                "recombine",
+                "sphere",
+                "--algo",
+                "greedy",
+                "--min-eta",
+                "-1e-300",
+            ],
+            "--min-eta: the lowest eta must lie in [0, 1], not -1e-300",
+        ),
+        (
+            &["optimum", "sphere", "--min-eta", "-.5"],
+            "--min-eta: the lowest eta must lie in [0, 1], not -0.5",
+        ),
+        (
+            &["sweep", "--algo", "selective", "--horizons", "-1e-3"],
+            "invalid value '-1e-3' for '--horizons",
+        ),
+        // A flag where a value was due is still a missing value.
+        (
+            &["recombine", "sphere", "--algo", "greedy", "-o", "--json"],
+            "a value is required for '--output",
+        ),
     ] {
         fails_with(tmp.path(), args, 2, message);
     }
