@@ -168,6 +168,14 @@ fn join_negative_numbers(
 /// Parses the command line and runs the subcommand.
 pub fn run() -> anyhow::Result<ExitCode> {
     let mut cmd = command();
+    // clap's own message names no argument.
+    if let Some(arg) = std::env::args_os().skip(1).find(|a| a.to_str().is_none()) {
+        return Err(UsageError(format!(
+            "the argument {arg:?} is not valid UTF-8: meshes, paths and names are recorded as \
+             text (JSON, CSV, .msh); rename the file, or link to it under a UTF-8 name"
+        ))
+        .into());
+    }
     let args = join_negative_numbers(&cmd, std::env::args_os());
     let matches = cmd
         .try_get_matches_from_mut(args)

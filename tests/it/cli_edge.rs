@@ -144,6 +144,24 @@ fn exit_2_usage_error() {
         fails_with(tmp.path(), args, 2, message);
     }
     assert!(!tmp.path().join("a").exists(), "refused before any work");
+    // An argument that is not UTF-8 is named (clap's message named none).
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let name = std::ffi::OsStr::from_bytes(b"m\xff.msh");
+        std::fs::write(tmp.path().join(name), "").unwrap();
+        let o = Command::new(bin())
+            .arg("info")
+            .arg(name)
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.starts_with("error: the argument \"m\\xFF.msh\" is not valid UTF-8"),
+            "{err}"
+        );
+    }
     // A method's parameter out of range names the flag that carried it.
     fails_with(
         tmp.path(),
