@@ -741,3 +741,23 @@ fn a_table_of_another_mesh_and_overlapping_quads_are_refused() {
     let m = message(&|| drop(quadrecomb::recombined(&sphere, &ts, &[u32::MAX - 1])));
     assert!(m.contains("does not exist"), "{m}");
 }
+
+/// On a torus, lockstep searches meet round the handle (a quad touching one dead component
+/// twice need not cut there). Their verdicts are certified by the paths that join them
+/// (`join_paths`), not by everything they visited, so an action on what they visited no
+/// longer sends each back to a search round the handle: uniform h = 2 on the suite's torus
+/// took 1.4 s for that. Its criterion's searches visited 5,004 triangles per triangle of the
+/// mesh before, 471 now (the same run: 17,878 searches then, 9,778 now).
+#[test]
+fn searches_that_met_are_certified_by_their_joining_paths() {
+    use quadrecomb::internals::mesh::{load, suite};
+    let member = suite::member("torus").expect("a suite member");
+    let mesh = load(&suite::spec(member)).expect("the torus loads");
+    let table = CandidateTable::build(&mesh).restrict(&mesh, Rule::default());
+    let mut searcher = Searcher::new(&mesh, &table);
+    let out = searcher.run(Algo::uniform(2), 0);
+    assert!(out.quads > 0);
+    let (_, searched) = searcher.criterion_work();
+    let per = searched as f64 / mesh.num_triangles() as f64;
+    assert!(per < 1000.0, "{per:.1} triangles searched per triangle");
+}

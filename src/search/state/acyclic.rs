@@ -93,6 +93,7 @@ impl State<'_> {
         let upper = if a.parent[t1 as usize] == t0 { t0 } else { t1 };
         debug_assert!(a.parent[t0 as usize] == t1 || a.parent[t1 as usize] == t0);
         let nb = self.cand[c as usize].nb;
+        self.path.clear();
         self.nsearch = 0;
         self.narcs = 0;
         let mut odd = 0;

@@ -181,6 +181,8 @@ impl<'a> State<'a> {
             nseed: [0; 4],
             cert_len: [0; 4],
             finished: [false; 4],
+            path_bfs: Vec::new(),
+            path: Vec::new(),
             group: [0; 4],
             nsearch: 0,
             changed: Vec::new(),

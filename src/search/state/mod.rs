@@ -22,7 +22,8 @@
 //!   met (one part) or all but one finished. Finished groups are whole parts (sizes known),
 //!   the last part's size is `|P| - 2 - (the others)`, so the cost is the smaller parts.
 //! * **Certificates.** A verdict stays valid while (a) the link vertices it may use keep no
-//!   removed triangle, (b) every triangle its search visited remains, and (c) for verdicts
+//!   removed triangle, (b) every triangle its search visited remains (where searches met,
+//!   only the paths that join them: `join_paths`), and (c) for verdicts
 //!   that found a split, the parity of the polder holding the candidate is unchanged. So
 //!   applying an action rechecks only: the candidates at vertices whose fan just lost its
 //!   first triangle, the verdicts watching the two removed triangles, and, when a polder
@@ -335,6 +336,11 @@ pub struct State<'a> {
     cert_len: [usize; 4],
     /// Split: whether each search's group finished (its queue is a whole part).
     finished: [bool; 4],
+    /// The breadth-first search of [`State::join_paths`]: triangle and parent index.
+    path_bfs: Vec<[u32; 2]>,
+    /// Part of the last check's certificate: the paths joining searches that met
+    /// ([`State::join_paths`]); empty when none met.
+    path: Vec<u32>,
     group: [u8; 4],
     nsearch: usize,
     changed: Vec<u32>,

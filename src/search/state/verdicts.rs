@@ -70,6 +70,12 @@ impl State<'_> {
                     self.watch_push(t, c, ver);
                 }
             }
+            if r.mask & READ == 0 {
+                for i in 0..self.path.len() {
+                    let t = self.path[i];
+                    self.watch_push(t, c, ver);
+                }
+            }
             // Linked groups: every arc's root must stay a root.
             for i in 0..self.narcs {
                 self.root_watch_push(self.arc_roots[i], c, ver);
