@@ -155,16 +155,18 @@ impl Progress {
             let shared = Arc::clone(&shared);
             std::thread::spawn(move || {
                 let mut stop = shared.stop.lock().unwrap_or_else(|p| p.into_inner());
-                loop {
+                // The flag is read before each wait: a stop set before this thread first
+                // took the lock (a sweep of a few milliseconds) was waited out for a whole
+                // period, 5 s more for every short sweep whose progress was plain lines.
+                while !*stop {
                     let (guard, _) = shared
                         .wake
-                        .wait_timeout(stop, PLAIN_PERIOD)
+                        .wait_timeout_while(stop, PLAIN_PERIOD, |stop| !*stop)
                         .unwrap_or_else(|p| p.into_inner());
                     stop = guard;
-                    if *stop {
-                        break;
+                    if !*stop {
+                        noteln!("{}", line(&shared));
                     }
-                    noteln!("{}", line(&shared));
                 }
             })
         });
@@ -272,6 +274,20 @@ pub fn calibrated_line(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A sweep that ends as soon as it starts does not wait out the plain ticker's period
+    /// (it did in about half of the tries: the stop came before the ticker's first wait).
+    #[test]
+    fn a_plain_display_stops_at_once() {
+        let start = Instant::now();
+        for _ in 0..40 {
+            let mut p = Progress::new(ProgressMode::Plain, 1);
+            p.inc();
+            p.finish();
+        }
+        // 40 tries, each of which waited 5 s when the race was lost.
+        assert!(start.elapsed() < PLAIN_PERIOD, "{:?}", start.elapsed());
+    }
 
     #[test]
     fn plain_line_counts_and_estimates() {
