@@ -21,6 +21,9 @@ pub struct Args {
     /// stderr.
     #[arg(long)]
     json: bool,
+    /// Quiet: only errors and warnings on stderr (as `sweep -q`).
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -28,12 +31,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let start = std::time::Instant::now();
     super::errors::check_results_dir(&args.out)?;
     let merged = merge(&args.dirs, &args.out)?;
-    noteln!(
-        "merge: {} runs from {} directories into {}",
-        merged.records,
-        merged.parts,
-        args.out.display()
-    );
+    if !args.quiet {
+        noteln!(
+            "merge: {} runs from {} directories into {}",
+            merged.records,
+            merged.parts,
+            args.out.display()
+        );
+    }
     let mut report = serde_json::Value::Null;
     if !args.no_report {
         let out = &args.out;
@@ -50,7 +55,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 out.display()
             )
         })?;
-        noteln!("merge: report in {}", paths.markdown.display());
+        if !args.quiet {
+            noteln!("merge: report in {}", paths.markdown.display());
+        }
         report = super::report::paths_json(&paths);
     }
     if args.json {

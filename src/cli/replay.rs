@@ -71,7 +71,7 @@ fn choose_config<'r>(
     results: &'r Results,
     args: &Args,
 ) -> Result<(&'r Config, &'r [Run]), UsageError> {
-    let found = results.groups.iter().find(|(c, _)| {
+    let found = results.configs().find(|(c, _)| {
         args.mesh.as_ref().is_none_or(|m| *m == c.mesh)
             && args.algo.as_ref().is_none_or(|a| *a == c.algo)
             && args.horizon.is_none_or(|h| Some(h) == c.horizon)
@@ -87,8 +87,8 @@ fn choose_config<'r>(
     asked.extend(args.horizon.map(|h| format!("horizon {h}")));
     asked.extend(args.budget.map(|b| format!("budget {b}")));
     asked.extend(args.time_budget.map(|t| format!("time budget {t}")));
-    let held: Vec<String> = (results.groups.keys())
-        .map(|c| format!("{} {}", c.mesh, c.label()))
+    let held: Vec<String> = (results.configs())
+        .map(|(c, _)| format!("{} {}", c.mesh, c.label()))
         .collect();
     Err(UsageError(format!(
         "{}: no configuration with {} (it holds: {})",

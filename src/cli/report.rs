@@ -97,6 +97,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|s| parse_picture(s))
         .collect::<Result<Vec<_>, _>>()?;
+    if args.baseline.is_some()
+        && let Ok(r) = quadrecomb::internals::report::Results::read(&args.dir)
+        && r.meshes.len() < 2
+    {
+        noteln!(
+            "warning: report: --baseline sets the method the \"Across meshes\" section compares \
+             with, and a directory of one mesh has no such section: it changes nothing"
+        );
+    }
     let opts = ReportOptions {
         compare: args.compare,
         zoom,

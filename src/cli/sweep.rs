@@ -208,6 +208,27 @@ fn parse_horizons(s: &str) -> Result<Horizons, String> {
     Ok(Horizons(list))
 }
 
+/// Warns of `--horizons` or `--budgets` given where no method of `--algo` reads them (the
+/// sweep runs without them, as asked, but the user probably meant another method).
+fn ignored_flags(algos: &[String], horizons: bool, budgets: bool) {
+    use quadrecomb::internals::experiment::plan::{has_budget, has_horizon};
+    use quadrecomb::internals::search::methods;
+    for (given, flag, reads) in [
+        (horizons, "--horizons", has_horizon as fn(&str) -> bool),
+        (budgets, "--budgets", has_budget),
+    ] {
+        if given && !algos.iter().any(|a| reads(a)) {
+            let readers: Vec<&str> = methods::names().filter(|m| reads(m)).collect();
+            noteln!(
+                "warning: sweep: {flag} is read by {} only, and --algo has none of them ({}): \
+                 it changes nothing",
+                readers.join(", "),
+                algos.join(" ")
+            );
+        }
+    }
+}
+
 /// A `--time-budgets` value, with the flag in its error.
 fn parse_time_budget(s: &str) -> Result<TimeBudget, String> {
     s.parse::<TimeBudget>()
@@ -394,6 +415,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if args.runs == Some(0) {
         return Err(config_error(ConfigError::ZeroRuns).into());
     }
+    let (horizons_given, budgets_given) = (args.horizons.is_some(), !args.budgets.is_empty());
     let config = SweepConfig::new(SweepRequest {
         meshes,
         algos: if args.algos.is_empty() {
@@ -428,6 +450,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ),
     })
     .map_err(config_error)?;
+    ignored_flags(config.algos(), horizons_given, budgets_given);
     let fixed: Vec<&str> = (config.algos().iter())
         .map(String::as_str)
         .filter(|a| quadrecomb::internals::experiment::plan::runs_as_baseline(a))

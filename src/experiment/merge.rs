@@ -41,6 +41,21 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
             kind: crate::mesh::file_kind(&meta).to_string(),
         });
     }
+    for (i, p) in parts.iter().enumerate() {
+        let canonical = |q: &Path| std::fs::canonicalize(q).ok();
+        let same = |q: &PathBuf| q == p || canonical(q).is_some_and(|c| Some(c) == canonical(p));
+        if let Some(q) = parts[..i].iter().find(|q| same(q)) {
+            let also = if q == p {
+                String::new()
+            } else {
+                format!(" (also as {})", q.display())
+            };
+            return Err(ExperimentError::Merge(format!(
+                "{}: given twice{also}",
+                p.display()
+            )));
+        }
+    }
     let mut manifests = Vec::new();
     for p in parts {
         if !p.is_dir() {
@@ -364,6 +379,18 @@ mod tests {
             .to_string();
         assert!(err.contains("runs are missing"), "{err}");
         let dup = vec![s[0].clone(), s[1].clone(), s[2].clone(), s[0].clone()];
+        let err = merge(&dup, &tmp.path().join("o2")).unwrap_err().to_string();
+        assert!(err.ends_with("s1: given twice"), "{err}");
+        // A copy is another directory holding the same runs.
+        let copy = tmp.path().join("copy");
+        std::fs::create_dir(&copy).unwrap();
+        for e in std::fs::read_dir(&s[0]).unwrap() {
+            let e = e.unwrap();
+            if e.file_type().unwrap().is_file() {
+                std::fs::copy(e.path(), copy.join(e.file_name())).unwrap();
+            }
+        }
+        let dup = vec![s[0].clone(), s[1].clone(), s[2].clone(), copy];
         let err = merge(&dup, &tmp.path().join("o2")).unwrap_err().to_string();
         assert!(err.contains("is in both"), "{err}");
 

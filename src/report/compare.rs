@@ -38,7 +38,28 @@ pub(super) fn compare_section(doc: &mut Document, a: &Results, b: &Results, seed
     if !only_b.is_empty() {
         notes.push(format!("Only in the second: {}.", only_b.join(", ")));
     }
+    let optimum = |r: &Results, mesh: &str| {
+        let m = r.manifest.as_ref()?;
+        let e = m.optimum.iter().find(|e| e.mesh == mesh)?;
+        Some(format!("{:.2}", e.quality))
+    };
+    let mut rules_noted: Vec<&str> = Vec::new();
     for (c, ra, rb) in &common {
+        let (rule_a, rule_b) = (ra[0].rule(), rb[0].rule());
+        if rule_a != rule_b && !rules_noted.contains(&c.mesh.as_str()) {
+            rules_noted.push(&c.mesh);
+            let optima = match (optimum(a, &c.mesh), optimum(b, &c.mesh)) {
+                (Some(x), Some(y)) => format!(" ({x} vs {y})"),
+                _ => String::new(),
+            };
+            notes.push(format!(
+                "{}: the two directories used different quad-validity rules ({rule_a} vs \
+                 {rule_b}): quality is a % of each rule's own optimum{optima}, and which \
+                 pairs may be merged differs, so the differences below are partly the rule's, \
+                 not the method's.",
+                c.mesh
+            ));
+        }
         if ra[0].mesh_hash != rb[0].mesh_hash {
             notes.push(format!(
                 "{}: the two directories used different meshes under the same name (hashes \

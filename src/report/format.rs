@@ -45,6 +45,11 @@ pub fn fmt_opt(v: Option<f64>, decimals: usize) -> String {
     v.map_or("–".to_string(), |v| format!("{v:.decimals$}"))
 }
 
+/// A median of counts as `13` or `13.5`, or `–` when none.
+pub fn fmt_count(v: Option<f64>) -> String {
+    v.map_or("–".to_string(), |v| format!("{v}"))
+}
+
 /// File-name-safe form of a mesh name: its [`slug`] when that is the name itself, else the
 /// slug and 8 hex digits of the name's hash (`a b` and `a-b` both gave `a-b`, and their
 /// figures overwrote each other).

@@ -2,7 +2,7 @@
 //! quality table, then the paper's numbers, box plots, pictures and statistical comparisons
 //! (each from its own module).
 
-use super::format::{fmt_opt, fmt_sig};
+use super::format::{fmt_count, fmt_opt, fmt_sig};
 use super::significance::{self, Family};
 use super::summarized::{median_of, metric_median};
 use super::{Config, Document, Metric, ReportError, ReportOptions, Results, Run, results};
@@ -157,8 +157,9 @@ pub(super) fn element_table(doc: &mut Document, summary: &Summary, configs: &[(&
         vec![
             fmt_opt(median_of(summary, c, |g| g.mean_eta.as_ref()), 4),
             fmt_opt(median_of(summary, c, |g| g.worst_eta.as_ref()), 4),
-            fmt_opt(median_of(summary, c, |g| g.quads_eta_below_0_1.as_ref()), 1),
-            fmt_opt(median_of(summary, c, |g| g.quads_eta_below_0_3.as_ref()), 1),
+            // Medians of counts: whole, or halves (an even number of runs).
+            fmt_count(median_of(summary, c, |g| g.quads_eta_below_0_1.as_ref())),
+            fmt_count(median_of(summary, c, |g| g.quads_eta_below_0_3.as_ref())),
             format!(
                 "{}",
                 median(

@@ -29,13 +29,23 @@ pub(super) fn overview(doc: &mut Document, results: &Results) {
             doc.para(format!(
                 "Incomplete sweep: {recorded} of the {planned} runs planned {} are recorded (it \
                  was interrupted, or is still running). Run the same quadrecomb sweep command \
-                 with --resume to finish it. The medians, tests and figures below are over the \
+                 (the same flags, this directory as --out) with --resume to finish it. The medians, tests and figures below are over the \
                  recorded runs, so configurations may hold fewer runs than planned and \
                  different numbers of them.",
                 m.shard
                     .map_or("in this directory".to_string(), |s| format!("in shard {s}")),
             ));
         }
+    }
+    if let Some((m, s)) = (results.manifest.as_ref()).and_then(|m| m.shard.map(|s| (m, s))) {
+        doc.para(format!(
+            "Shard {s} of a sweep: this directory holds {} of its {} runs, so each \
+             configuration here has about 1/{} of the runs planned for it. Merge the shards \
+             (quadrecomb merge DIR1 DIR2 ... --out DIR) for the whole sweep's report.",
+            plan::shard(plan::plan(&m.spec), m.shard).len(),
+            plan::plan(&m.spec).len(),
+            s.count,
+        ));
     }
     let mut rules: Vec<String> = runs.iter().map(|r| r.rule().to_string()).collect();
     rules.sort_unstable();

@@ -93,7 +93,8 @@ pub struct Results {
     pub dir: PathBuf,
     /// Runs per configuration, in report order, each group sorted by run index.
     pub groups: BTreeMap<Config, Vec<Run>>,
-    /// Meshes in report order (order of first appearance in `runs.jsonl`).
+    /// Meshes in report order: the sweep's (`--mesh`, as the manifest lists them), then any
+    /// other in order of first appearance in `runs.jsonl`.
     pub meshes: Vec<String>,
     /// `manifest.json`, if present.
     pub manifest: Option<manifest::Manifest>,
@@ -167,6 +168,12 @@ impl Results {
         for g in groups.values_mut() {
             g.sort_by_key(|r| r.run);
         }
+        // Not the order in which runs finished: with several threads that changed from one
+        // sweep to the next, and with it the report's sections and tables.
+        if let Some(m) = &manifest {
+            let rank = |name: &String| m.spec.meshes.iter().position(|e| e.name == *name);
+            meshes.sort_by_key(|name| rank(name).unwrap_or(usize::MAX));
+        }
         Results {
             dir: dir.to_path_buf(),
             groups,
@@ -174,6 +181,12 @@ impl Results {
             manifest,
             torn_bytes,
         }
+    }
+
+    /// Every configuration in report order: mesh by mesh ([`Results::meshes`]), each
+    /// mesh's in [`Config`] order.
+    pub fn configs(&self) -> impl Iterator<Item = (&Config, &[Run])> {
+        self.meshes.iter().flat_map(|m| self.configs_of(m))
     }
 
     /// Configurations of `mesh`, in report order.

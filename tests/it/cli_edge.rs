@@ -931,3 +931,112 @@ fn a_stdout_that_cannot_be_written_is_exit_1() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A review's papercuts: flags that change nothing are said to; `merge -q` is quiet as `sweep
+/// -q` is; a directory given twice to `merge` is named so; a shard's report says it is one.
+#[test]
+fn flags_that_change_nothing_are_warned_of() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let sweep = |out: &str, extra: &[&str]| {
+        let mut args = vec![
+            "sweep",
+            "--mesh",
+            "sphere",
+            "--backend",
+            "cpu",
+            "--out",
+            out,
+            "-q",
+        ];
+        args.extend(extra);
+        let o = run_in(dir, &args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let err = sweep("a", &["--algo", "greedy", "--horizons", "3", "--no-report"]);
+    assert!(
+        err.contains(
+            "warning: sweep: --horizons is read by uniform, selective, optimistic, mcts, beam \
+             only, and --algo has none of them (greedy): it changes nothing"
+        ),
+        "{err}"
+    );
+    let err = sweep(
+        "b",
+        &[
+            "--algo",
+            "selective",
+            "--horizons",
+            "1",
+            "--runs",
+            "2",
+            "--budgets",
+            "8",
+            "--no-report",
+        ],
+    );
+    assert!(
+        err.contains("warning: sweep: --budgets is read by optimistic, mcts, beam only"),
+        "{err}"
+    );
+    // Warned of once, and not where a method reads them.
+    assert_eq!(err.matches("warning").count(), 1, "{err}");
+    let err = sweep(
+        "c",
+        &[
+            "--algo",
+            "selective",
+            "--horizons",
+            "1",
+            "--runs",
+            "2",
+            "--no-report",
+        ],
+    );
+    assert_eq!(err, "");
+    let o = run_in(
+        dir,
+        &["report", "c", "--baseline", "greedy", "--no-pictures"],
+    );
+    assert!(
+        stderr(&o).contains("warning: report: --baseline sets the method the \"Across meshes\""),
+        "{}",
+        stderr(&o)
+    );
+    // Shards, merged quietly; a part given twice.
+    for s in ["1/2", "2/2"] {
+        let out = format!("s{}", &s[..1]);
+        sweep(
+            &out,
+            &[
+                "--algo",
+                "greedy",
+                "selective",
+                "--horizons",
+                "1",
+                "--runs",
+                "4",
+                "--shard",
+                s,
+            ],
+        );
+    }
+    let o = run_in(dir, &["report", "s1", "--no-pictures"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = std::fs::read_to_string(dir.join("s1/report.md")).unwrap();
+    assert!(
+        md.contains("Shard 1/2 of a sweep: this directory holds 3 of its 5 runs"),
+        "{md}"
+    );
+    let o = run_in(dir, &["merge", "s1", "s2", "--out", "m", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "");
+    assert!(o.stdout.is_empty());
+    fails_with(
+        dir,
+        &["merge", "s1", "s1", "s2", "--out", "n"],
+        3,
+        "merge: s1: given twice",
+    );
+}

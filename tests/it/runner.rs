@@ -516,7 +516,7 @@ fn merge_rejects_foreign_missing_and_duplicated_parts() {
         &["merge", "p1", "p2", "p2", "--out", "m3", "--no-report"],
     );
     assert_eq!(dup.status.code(), Some(3));
-    assert!(stderr(&dup).contains("is in both"), "{}", stderr(&dup));
+    assert!(stderr(&dup).contains("p2: given twice"), "{}", stderr(&dup));
 
     // Shards cut with another --shard count are named as such, not as a duplicated run.
     let args = sweep_args(&mesh, "r3", 3, "1..2");
