@@ -390,7 +390,8 @@ impl State<'_> {
     /// s`): makes that group's share of the certificate the paths that join its searches
     /// (in `path`, `cert_len` 0 for its searches), not every triangle they visited (the
     /// queues stay whole: a split's parts are relabelled from them). A breadth-first search through the group's visited triangles from the
-    /// first search's seeds reaches a seed of every other one; the tree paths back from
+    /// first search's seeds reaches a seed of every other one (a search's seeds count as
+    /// one: their links are certified apart); the tree paths back from
     /// those seeds are the certificate. While those triangles remain, the searches' groups
     /// stay one part (the links within a search's seeds are certified apart: clean
     /// vertices, linked arcs' roots). Searches meet where the quad touches one dead
@@ -406,18 +407,24 @@ impl State<'_> {
         let others = || (first + 1..4).filter(move |&s| members & (1 << s) != 0);
         let mut bfs = std::mem::take(&mut self.path_bfs);
         bfs.clear();
+        // A search's seeds are joined by the links that grouped them (clean vertices,
+        // linked arcs), not always through the triangles visited so far: reaching one
+        // reaches them all (a step of no triangle, certified apart).
+        let seed_search = |t: u32| {
+            (1..4).find(|&s| members & (1 << s) != 0 && self.queue[s][..self.nseed[s]].contains(&t))
+        };
         for &t in &self.queue[first][..self.nseed[first]] {
             self.stamp[t as usize] = base | REACHED;
             bfs.push([t, NONE]);
         }
-        // The index in `bfs` of the seed reached for each other search.
+        // The index in `bfs` of the seed reached first for each other search.
         let mut target = [NONE; 4];
         let mut left = others().count();
         let mut head = 0;
         while left > 0 {
             let Some(&[x, _]) = bfs.get(head) else {
-                // Unreachable (the searches met through these triangles); were it reached,
-                // every visited triangle is a certificate as before.
+                // Unreachable (the searches met through these triangles and links); were it
+                // reached, every visited triangle is a certificate as before.
                 debug_assert!(false, "the met searches' triangles join their seeds");
                 for s in 0..4 {
                     if members & (1 << s) != 0 {
@@ -437,10 +444,17 @@ impl State<'_> {
                 }
                 *m = base | REACHED;
                 bfs.push([u, head as u32]);
-                for s in others() {
-                    if target[s] == NONE && self.queue[s][..self.nseed[s]].contains(&u) {
-                        target[s] = bfs.len() as u32 - 1;
-                        left -= 1;
+                let at = bfs.len() as u32 - 1;
+                if let Some(s) = seed_search(u)
+                    && target[s] == NONE
+                {
+                    target[s] = at;
+                    left -= 1;
+                    for &t in &self.queue[s][..self.nseed[s]] {
+                        if self.stamp[t as usize] != base | REACHED {
+                            self.stamp[t as usize] = base | REACHED;
+                            bfs.push([t, at]);
+                        }
                     }
                 }
             }
