@@ -202,7 +202,7 @@ impl Rule {
 
     /// [`Rule::allows_pair`] with the quad's eta computed here. The same answer, but for
     /// most quads without eq. 1's six arctangents: a quad whose corners are clear of 0 and pi
-    /// ([`corners_clear`]) has eta > [`FLAT_ETA`] unless folded, one with a reflex corner
+    /// (`corners_clear`) has eta > [`FLAT_ETA`] unless folded, one with a reflex corner
     /// has eta 0, and only a quad within 1e-9 of either (or degenerate) is measured. The
     /// arctangents were most of the valid-quad rule's cost outside the search: a fifth of
     /// `recombine`'s time on a 10^5-triangle grid.
