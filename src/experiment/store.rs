@@ -2,7 +2,9 @@
 //!
 //! A kill can leave at most one torn line: the last one, without its newline. Reading ignores
 //! it (that run is redone) and [`RunLog::open_for_append`] truncates it away before appending,
-//! so a resumed file never holds half a record. A complete line that does not parse is not a
+//! so a resumed file never holds half a record. A last line that lacks only its newline (a
+//! kill just before it, or a file saved by an editor) is a whole record: it is read, and
+//! appending first ends its line. A complete line that does not parse is not a
 //! kill's doing: it is reported as corruption rather than skipped.
 
 use std::fs::{File, OpenOptions};
@@ -25,9 +27,10 @@ pub struct Loaded {
     pub lines: Vec<String>,
     /// The 1-based line number of each record in the file, for messages.
     pub line_numbers: Vec<usize>,
-    /// Length in bytes of the complete lines (where appending resumes).
+    /// Length in bytes of the complete lines (where appending resumes), a last record
+    /// without its newline included.
     pub valid_len: u64,
-    /// Bytes of a torn last line (no newline), ignored; 0 if none.
+    /// Bytes of a torn last line (no newline, not a whole record), ignored; 0 if none.
     pub torn_bytes: u64,
 }
 
@@ -60,11 +63,24 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
         Err(e) => return Err(ExperimentError::io(path, e)),
     };
-    let valid_len = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let mut valid_len = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let mut torn_bytes = bytes.len() - valid_len;
+    let tail = &bytes[valid_len..];
+    if tail.iter().all(u8::is_ascii_whitespace) {
+        // Trailing blanks: nothing torn, and appending truncates them.
+        torn_bytes = 0;
+    } else if serde_json::from_slice::<RunRecord>(tail).is_ok() {
+        // A whole record without its newline: read like the others.
+        valid_len = bytes.len();
+        torn_bytes = 0;
+    }
     let mut records = Vec::new();
     let mut lines = Vec::new();
     let mut line_numbers = Vec::new();
-    for (n, line) in bytes[..valid_len].split(|&b| b == b'\n').enumerate() {
+    let complete = bytes[..valid_len]
+        .strip_suffix(b"\n")
+        .unwrap_or(&bytes[..valid_len]);
+    for (n, line) in complete.split(|&b| b == b'\n').enumerate() {
         if line.iter().all(u8::is_ascii_whitespace) {
             continue;
         }
@@ -89,7 +105,7 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
         lines,
         line_numbers,
         valid_len: valid_len as u64,
-        torn_bytes: (bytes.len() - valid_len) as u64,
+        torn_bytes: torn_bytes as u64,
     })
 }
 
@@ -136,24 +152,37 @@ pub struct RunLog {
 
 impl RunLog {
     /// Opens `path` for appending after its first `valid_len` bytes, truncating anything after
-    /// them (a torn last line). Creates the file if needed.
+    /// them (a torn last line), and ends a last line that lacks its newline. Creates the file
+    /// if needed.
     pub fn open_for_append(path: &Path, valid_len: u64) -> Result<RunLog, ExperimentError> {
-        let file = OpenOptions::new()
+        use std::io::{Read, Seek};
+        let mut file = OpenOptions::new()
             .create(true)
             .truncate(false)
+            .read(true)
             .write(true)
             .open(path)
             .map_err(|e| ExperimentError::io(path, e))?;
+        let mut last = [b'\n'];
+        if valid_len > 0 {
+            file.seek(std::io::SeekFrom::Start(valid_len - 1))
+                .and_then(|_| file.read_exact(&mut last))
+                .map_err(|e| ExperimentError::io(path, e))?;
+        }
         file.set_len(valid_len)
             .map_err(|e| ExperimentError::io(path, e))?;
         let mut log = RunLog {
             path: path.to_path_buf(),
             file,
         };
-        use std::io::Seek;
         log.file
             .seek(std::io::SeekFrom::Start(valid_len))
             .map_err(|e| ExperimentError::io(path, e))?;
+        if last[0] != b'\n' {
+            log.file
+                .write_all(b"\n")
+                .map_err(|e| ExperimentError::io(path, e))?;
+        }
         Ok(log)
     }
 
@@ -285,6 +314,55 @@ pub(crate) mod tests {
         drop(log);
         assert_eq!(std::fs::read(&path).unwrap(), full);
         assert_eq!(read(&path).unwrap().records, vec![record(0), record(1)]);
+    }
+
+    /// A last record that lacks only its newline (a kill just before it, an editor's save)
+    /// is read, and appending ends its line first; trailing blanks are not a torn line. Every
+    /// proper prefix of a record is still torn.
+    #[test]
+    fn a_last_record_without_its_newline_is_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(RUNS_FILE);
+        let mut full = String::new();
+        for r in 0..3 {
+            full.push_str(&record(r).to_json_line());
+            full.push('\n');
+        }
+        for lines in 1..=2 {
+            let text: String = full.split_inclusive('\n').take(lines).collect();
+            let unterminated = text.trim_end_matches('\n');
+            std::fs::write(&path, unterminated).unwrap();
+            let loaded = read(&path).unwrap();
+            assert_eq!(
+                loaded.records,
+                (0..lines as u32).map(record).collect::<Vec<_>>()
+            );
+            assert_eq!(loaded.line_numbers, (1..=lines).collect::<Vec<_>>());
+            assert_eq!(
+                (loaded.valid_len, loaded.torn_bytes),
+                (unterminated.len() as u64, 0)
+            );
+            let mut log = RunLog::open_for_append(&path, loaded.valid_len).unwrap();
+            for r in lines as u32..3 {
+                log.append(&record(r)).unwrap();
+            }
+            drop(log);
+            assert_eq!(std::fs::read_to_string(&path).unwrap(), full);
+        }
+        let first = record(0).to_json_line();
+        std::fs::write(&path, format!("{first}\n \t")).unwrap();
+        let loaded = read(&path).unwrap();
+        assert_eq!((loaded.records.len(), loaded.torn_bytes), (1, 0));
+        assert_eq!(loaded.valid_len, first.len() as u64 + 1);
+        for cut in 1..first.len() {
+            std::fs::write(&path, &first[..cut]).unwrap();
+            let loaded = read(&path).unwrap();
+            assert!(
+                loaded.records.is_empty(),
+                "prefix of {cut} bytes read as a record"
+            );
+            assert_eq!((loaded.valid_len, loaded.torn_bytes), (0, cut as u64));
+        }
     }
 
     #[test]
