@@ -124,8 +124,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .transpose()?;
     // Its exit code follows the error's kind (`errors::exit_code`).
     let paths = report::write(&args.dir, &opts)?;
+    for w in &paths.warnings {
+        noteln!("warning: report: {}: {w}", args.dir.display());
+    }
     if args.json {
         let mut v = paths_json(&paths);
+        v["warnings"] = serde_json::json!(paths.warnings);
         v["dir"] = serde_json::json!(args.dir);
         v["time_s"] = serde_json::json!(start.elapsed().as_secs_f64());
         outln!("{v}");

@@ -119,6 +119,9 @@ pub struct ReportPaths {
     pub figures: Vec<PathBuf>,
     /// `across_meshes.csv`, the per-mesh medians, written for two or more meshes.
     pub across_csv: Option<PathBuf>,
+    /// What the report says that its reader should hear at once (an incomplete sweep, a
+    /// torn last line), one line each.
+    pub warnings: Vec<String>,
 }
 
 pub use crate::experiment::engine::FIGURES_DIR;
@@ -210,6 +213,7 @@ pub fn write(dir: &Path, opts: &ReportOptions) -> Result<ReportPaths, ReportErro
     let title = format!("quadrecomb report: {}", dir.display());
     crate::output::write_bytes(&html, doc.to_html(&title).as_bytes()).map_err(io(&html))?;
     Ok(ReportPaths {
+        warnings: overview::warnings(&results),
         markdown,
         html,
         figures,

@@ -22,9 +22,7 @@ pub(super) fn overview(doc: &mut Document, results: &Results) {
         backends.join(", "),
     ));
     if let Some(m) = &results.manifest {
-        // The runs this directory's manifest plans (its shard's, for a shard).
-        let planned = plan::shard(plan::plan(&m.spec), m.shard).len();
-        let recorded = results.num_runs();
+        let (recorded, planned) = recorded_of_planned(results).unwrap_or_default();
         if recorded < planned {
             doc.para(format!(
                 "Incomplete sweep: {recorded} of the {planned} runs planned {} are recorded (it \
@@ -84,7 +82,7 @@ pub(super) fn overview(doc: &mut Document, results: &Results) {
     if results.torn_bytes > 0 {
         doc.para(
             "The last line of runs.jsonl was torn (a run interrupted while being written) and is \
-             not counted; `quadrecomb sweep --resume` redoes it.",
+             not counted; quadrecomb sweep --resume redoes it.",
         );
     }
     let labels: Vec<String> = results
@@ -96,4 +94,36 @@ pub(super) fn overview(doc: &mut Document, results: &Results) {
         })
         .collect();
     doc.para(format!("Configurations: {}.", labels.join("; ")));
+}
+
+/// The runs recorded and the runs this directory's manifest plans (its shard's, for a
+/// shard); `None` without a manifest.
+pub(crate) fn recorded_of_planned(results: &Results) -> Option<(usize, usize)> {
+    let m = results.manifest.as_ref()?;
+    Some((
+        results.num_runs(),
+        plan::shard(plan::plan(&m.spec), m.shard).len(),
+    ))
+}
+
+/// What a reader of the report alone would miss, one line each, for the command to print:
+/// runs planned but not recorded, a torn last line.
+pub(crate) fn warnings(results: &Results) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Some((recorded, planned)) = recorded_of_planned(results)
+        && recorded < planned
+    {
+        out.push(format!(
+            "incomplete sweep: {recorded} of the {planned} planned runs are recorded, and the \
+             report is over them; run the same sweep command with --resume to finish it"
+        ));
+    }
+    if results.torn_bytes > 0 {
+        out.push(
+            "the last line of runs.jsonl is torn (a run interrupted while being written) and \
+             not counted; sweep --resume redoes it"
+                .to_string(),
+        );
+    }
+    out
 }

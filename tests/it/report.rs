@@ -687,9 +687,7 @@ fn compare_two_directories() {
 fn report_of_an_unfinished_sweep_says_so() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let ok = |args: &[&str]| {
-        run_ok(dir, args);
-    };
+    let ok = |args: &[&str]| String::from_utf8_lossy(&run_ok(dir, args).stderr).into_owned();
     ok(&["generate", "grid", "--triangles", "300", "-o", "g.msh"]);
     ok(&[
         "sweep",
@@ -709,18 +707,27 @@ fn report_of_an_unfinished_sweep_says_so() {
         "--no-report",
     ]);
     let report_md = || {
-        ok(&["report", "s", "--no-pictures"]);
-        std::fs::read_to_string(dir.join("s/report.md")).unwrap()
+        let err = ok(&["report", "s", "--no-pictures"]);
+        (
+            std::fs::read_to_string(dir.join("s/report.md")).unwrap(),
+            err,
+        )
     };
-    let md = report_md();
+    let (md, err) = report_md();
     assert!(md.contains("9 runs in 3 configurations"), "{md}");
     assert!(!md.contains("Incomplete"), "{md}");
+    assert!(!err.contains("warning"), "{err}");
     // Keep the first five records, as an interrupted sweep leaves them.
     let runs = dir.join("s/runs.jsonl");
     let text = std::fs::read_to_string(&runs).unwrap();
     let kept: Vec<&str> = text.lines().take(5).collect();
     std::fs::write(&runs, kept.join("\n") + "\n").unwrap();
-    let md = report_md();
+    // Said on stderr too, for a script that does not read the report.
+    let (md, err) = report_md();
+    assert!(
+        err.contains("warning: report: s: incomplete sweep: 5 of the 9 planned runs"),
+        "{err}"
+    );
     assert!(
         md.contains("Incomplete sweep: 5 of the 9 runs planned in this directory are recorded"),
         "{md}"
@@ -743,6 +750,14 @@ fn torn_last_line_is_skipped_and_other_bad_lines_are_errors() {
     let paths = report::write(tmp.path(), &opts).unwrap();
     let md = std::fs::read_to_string(paths.markdown).unwrap();
     assert!(md.contains("torn"), "{md}");
+    assert!(
+        paths
+            .warnings
+            .iter()
+            .any(|w| w.contains("runs.jsonl is torn")),
+        "{:?}",
+        paths.warnings
+    );
     assert!(md.starts_with("# quadrecomb report"));
     assert!(md.contains("30 runs in 6 configurations"), "{md}");
 
