@@ -434,6 +434,22 @@ pub fn write_mesh_output(
     {
         noteln!("warning: {}: {note}", path.display());
     }
+    if vtu_ascii && !vtu {
+        noteln!(
+            "note: --vtu-ascii is ignored: {} is a .msh, MSH 4.1 ASCII either way",
+            path.display()
+        );
+    }
+    // Only `--allow-invalid` lets these through; the file does not say so.
+    let flat = rec.quad_eta.iter().filter(|&&eta| eta <= 0.0).count();
+    if flat > 0 {
+        noteln!(
+            "warning: {}: {flat} of its {} quads have eta 0 (a corner of pi or more: not \
+             strictly convex), as --allow-invalid allows; a finite-element solver rejects them",
+            path.display(),
+            rec.quads.len()
+        );
+    }
     quadrecomb::internals::output::write_atomic(path, |mut w| {
         if vtu {
             quadrecomb::internals::mesh::vtu::write_to(&mut w, mesh, rec, encoding)

@@ -39,7 +39,7 @@ pub struct Args {
     algo: String,
     /// Horizon of the tree policies (default 1 for uniform and selective, 10 for
     /// optimistic and mcts, 5 for beam; the greedy policies have none).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     horizon: Option<u32>,
     /// Tree nodes expanded per decision of optimistic, mcts and beam (default 64; the
     /// others have none).

@@ -25,7 +25,7 @@ pub struct Args {
     #[arg(long)]
     algo: Option<String>,
     /// Horizon of the configuration (default: the smallest recorded).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     horizon: Option<u32>,
     /// Node budget of the configuration, for optimistic, mcts and beam (default: the
     /// smallest recorded).

@@ -878,6 +878,62 @@ fn benchmarks_refuse_counts_of_zero() {
     }
 }
 
+/// `--horizon` is checked by clap from 1 up: `-1` was said to be "not in 0..=4294967295" and
+/// then 0 refused with "the horizon must be at least 1", which named no flag.
+#[test]
+fn horizons_start_at_one() {
+    let tmp = tempfile::tempdir().unwrap();
+    for h in ["0", "-1"] {
+        let recombine = ["recombine", "sphere", "--algo", "selective", "--horizon", h];
+        fails_with(tmp.path(), &recombine, 2, &format!("{h} is not in 1.."));
+        let replay = ["replay", "nowhere", "0", "--horizon", h];
+        fails_with(tmp.path(), &replay, 2, &format!("{h} is not in 1.."));
+    }
+}
+
+/// What a written mesh holds that its user may not expect is said on stderr: quads of eta 0
+/// under `--allow-invalid` (none under the default rule), and `--vtu-ascii` ignored by a .msh.
+#[test]
+fn written_meshes_say_what_they_hold() {
+    let tmp = tempfile::tempdir().unwrap();
+    let args = |extra: &[&'static str]| {
+        let mut a = vec![
+            "recombine",
+            "borouchaki",
+            "--algo",
+            "greedy",
+            "--no-optimum",
+        ];
+        a.extend_from_slice(extra);
+        a
+    };
+    let o = run_in(tmp.path(), &args(&["--allow-invalid", "-o", "a.msh"]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let line = err
+        .lines()
+        .find(|l| l.contains("have eta 0"))
+        .unwrap_or_else(|| panic!("{err}"));
+    assert!(line.starts_with("warning: a.msh: "), "{line}");
+    let n: usize = line["warning: a.msh: ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(n > 0, "{line}");
+    let o = run_in(tmp.path(), &args(&["-o", "b.msh", "--vtu-ascii"]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(!err.contains("have eta 0"), "{err}");
+    assert!(
+        err.contains("note: --vtu-ascii is ignored: b.msh is a .msh"),
+        "{err}"
+    );
+    let o = run_in(tmp.path(), &args(&["-o", "c.vtu", "--vtu-ascii"]));
+    assert!(!stderr(&o).contains("ignored"), "{}", stderr(&o));
+}
+
 /// A stdout that cannot be written (a full disk under `> out.json`; `/dev/full` here) is an
 /// error, exit 1, after the command's work: the JSON or table it meant to print is lost. A
 /// reader that stopped reading (`| head -1`) is not: exit 0. `completions` wrote through
