@@ -164,7 +164,13 @@ pub(crate) fn refine(
                 }
                 first = false;
                 if quad_sides.contains(&key(a, b)) {
-                    return Err(blocked(cur, a, b, "is shared with an input quad"));
+                    return Err(blocked(
+                        cur,
+                        a,
+                        b,
+                        "is shared with an input quad (sheets do not split input quads; \
+                         --finish without --all-quad finishes it, leaving triangles)",
+                    ));
                 }
                 let ct = mesh.triangles[cur as usize];
                 let s = side_of(ct, a, b).expect("the sheet's side is a side of its triangle");
