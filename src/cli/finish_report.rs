@@ -107,5 +107,12 @@ pub fn print(f: &Finished, table: &CandidateTable, pct: impl Fn(f64) -> Option<f
             (f.sheets.triangles_replaced + f.sheets.triangles_added) / 2
         );
     }
+    let added = f.splits.len() + f.sheets.triangles_added;
+    if added > 0 && pct(f.improved.quality).is_some() {
+        outln!(
+            "  note          all-quad added {added} triangles: the % above are of the input \
+             mesh's optimum, which the refined mesh can exceed (so can its quad count)"
+        );
+    }
     outln!("  finish time   {:.4} s", f.time_s());
 }
