@@ -130,12 +130,27 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Which::Index(i) => runs.iter().find(|r| r.run == i),
     };
     let Some(record) = record else {
+        // Only an index can be missing: a configuration holds runs, so a typical one.
+        let Which::Index(i) = which else {
+            anyhow::bail!("{}: no run to replay", args.dir.display());
+        };
+        let with: Vec<String> = (results.configs())
+            .filter(|(_, rs)| rs.iter().any(|r| r.run == i))
+            .map(|(c, _)| format!("{} {}", c.mesh, c.label()))
+            .collect();
+        let elsewhere = match with.len() {
+            0 => format!("no configuration here has a run {i}"),
+            n => format!(
+                "choose one with --mesh, --algo, --horizon or --budget; run {i} is in {}{}",
+                with[..n.min(6)].join("; "),
+                if n > 6 { "; ..." } else { "" }
+            ),
+        };
         return Err(UsageError(format!(
-            "{}: {} {} has no run {} (recorded runs: {})",
+            "{}: {} {} has no run {i} (its runs: {}); {elsewhere}",
             args.dir.display(),
             config.mesh,
             config.label(),
-            args.run,
             spans(runs.iter().map(|r| r.run))
         ))
         .into());

@@ -240,7 +240,20 @@ fn replay_refuses_what_it_cannot_reproduce() {
     let o = replay(t, &dir, "0", &r, &["-o", "out.stl"]);
     refused(&o, 2, "expected a .msh or .vtu file name");
     let o = replay(t, &dir, "7", &r, &[]);
-    refused(&o, 2, "has no run 7 (recorded runs: 0 to 2)");
+    refused(
+        &o,
+        2,
+        "has no run 7 (its runs: 0 to 2); no configuration here has a run 7",
+    );
+    // Without --algo, the first configuration is the baseline of one run; the message names
+    // the configurations that hold the run asked for.
+    let o = run_in(t, &["replay", dir.to_str().unwrap(), "2"]);
+    refused(
+        &o,
+        2,
+        "m greedy has no run 2 (its runs: 0); choose one with --mesh, --algo, --horizon or \
+         --budget; run 2 is in m selective h=1; m selective h=2",
+    );
     let o = replay(t, &dir, "first", &r, &[]);
     refused(&o, 2, "bad RUN \"first\"");
 
