@@ -1014,3 +1014,25 @@ fn elements_left_out_of_the_output_are_warned_about() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A binary file whose data size is not 8 is refused, naming what the size is of in each
+/// version (a double's in MSH 2.2, a size_t's in MSH 4.1; the message said size_t alone).
+#[test]
+fn a_binary_data_size_other_than_8_is_refused() {
+    for version in ["2.2", "4.1"] {
+        let mut b = format!("$MeshFormat\n{version} 1 4\n").into_bytes();
+        b.extend(1i32.to_le_bytes());
+        b.extend(b"\n$EndMeshFormat\n");
+        let err = quadrecomb::internals::mesh::msh::read_bytes("f.msh", &b)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("f.msh"), "{err}");
+        assert!(
+            err.contains(
+                "unsupported data size `4` in a binary file (only 8 is read: the size \
+                 of a double in MSH 2.2, of a size_t in MSH 4.1)"
+            ),
+            "{err}"
+        );
+    }
+}

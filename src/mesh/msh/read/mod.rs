@@ -95,7 +95,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<MshFile, ReadError> {
                 return Err(p.err(
                     dp,
                     format!(
-                        "unsupported data size `{}` in a binary file (only 8-byte size_t is read)",
+                        "unsupported data size `{}` in a binary file (only 8 is read: the size of a double in MSH 2.2, of a size_t in MSH 4.1)",
                         show(&data_size)
                     ),
                 ));
