@@ -86,6 +86,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         outln!("mesh            {}", args.mesh);
         outln!("triangles       {nt}");
+        if !mesh.quads.is_empty() {
+            outln!(
+                "input quads     {} (kept as they are; the figures below are of the triangles)",
+                mesh.quads.len()
+            );
+        }
         outln!("quads           {}", opt.quads);
         outln!("triangles left  {}", opt.triangles_left);
         outln!("recombined      {pct:.2} %");

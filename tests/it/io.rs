@@ -1914,3 +1914,22 @@ fn info_refuses_a_flat_quad_in_a_file_of_quads_only() {
     assert_eq!(o.status.code(), Some(3), "{err}");
     assert!(err.contains("flat.msh: quad 7 is degenerate"), "{err}");
 }
+
+/// `recombine` and `optimum` on a mesh with input quads say how many they keep: their figures
+/// are of the triangles alone, and read as the whole mesh's without the line.
+#[test]
+fn input_quads_are_counted_in_the_text_output() {
+    let tmp = tempfile::tempdir().unwrap();
+    let input = repo_path("tests/data/mixed_41_ascii.msh");
+    let input = input.to_str().unwrap();
+    let line = "input quads     11 (kept as they are; the figures below are of the triangles)";
+    for args in [
+        &["recombine", input, "--algo", "greedy", "--no-optimum"][..],
+        &["optimum", input],
+    ] {
+        let out = String::from_utf8_lossy(&run_ok(tmp.path(), args).stdout).into_owned();
+        assert!(out.contains(line), "{args:?}: {out}");
+    }
+    let out = run_ok(tmp.path(), &["optimum", "sphere"]).stdout;
+    assert!(!String::from_utf8_lossy(&out).contains("input quads"));
+}
