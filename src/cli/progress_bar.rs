@@ -74,7 +74,8 @@ pub fn cost_warning(p: &Progress, horizon: Option<u32>, hint: &str) -> Option<St
         );
     }
     Some(format!(
-        "warning: this run should take about {} ({why}){hint}",
+        "warning: this run should take about {} at its pace so far, longer if its later trees \
+         are larger ({why}){hint}",
         duration(total)
     ))
 }
@@ -174,7 +175,10 @@ mod tests {
             "10 s is fine"
         );
         let w = cost_warning(&at(20, 1.0), Some(10), H).expect("100 s is long");
-        assert!(w.contains("about 100 s") && w.ends_with(H), "{w}");
+        assert!(
+            w.contains("about 100 s at its pace so far") && w.ends_with(H),
+            "{w}"
+        );
         assert!(w.contains("1024 tree nodes per decision"), "{w}");
         // 1024 = 2^10: a branching factor of 2 over 10 levels.
         assert!(
