@@ -245,6 +245,17 @@ pub fn add_element_fields(
     v["allow_invalid"] = serde_json::json!(rule.allows_invalid());
 }
 
+/// The text output's line for a mesh's input quads, when it has any: the figures that
+/// follow are of its triangles alone.
+pub fn print_input_quads(mesh: &quadrecomb::internals::mesh::Mesh) {
+    if !mesh.quads.is_empty() {
+        outln!(
+            "input quads     {} (kept as they are; the figures below are of the triangles)",
+            mesh.quads.len()
+        );
+    }
+}
+
 /// The element-quality lines of the text output.
 pub fn print_element_lines(
     e: &quadrecomb::internals::quality::ElementQuality,

@@ -86,12 +86,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         outln!("mesh            {}", args.mesh);
         outln!("triangles       {nt}");
-        if !mesh.quads.is_empty() {
-            outln!(
-                "input quads     {} (kept as they are; the figures below are of the triangles)",
-                mesh.quads.len()
-            );
-        }
+        super::print_input_quads(&mesh);
         outln!("quads           {}", opt.quads);
         outln!("triangles left  {}", opt.triangles_left);
         outln!("recombined      {pct:.2} %");

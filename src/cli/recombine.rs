@@ -316,12 +316,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         outln!("mesh            {}", args.mesh);
         outln!("triangles       {nt}");
-        if !mesh.quads.is_empty() {
-            outln!(
-                "input quads     {} (kept as they are; the figures below are of the triangles)",
-                mesh.quads.len()
-            );
-        }
+        super::print_input_quads(&mesh);
         match (horizon, algo.budget()) {
             (Some(h), Some(b)) => outln!(
                 "algo            {} (horizon {h}, budget {b}, seed {})",

@@ -77,10 +77,7 @@ pub fn read(path: &Path) -> Result<Loaded, ExperimentError> {
     let mut records = Vec::new();
     let mut lines = Vec::new();
     let mut line_numbers = Vec::new();
-    let complete = bytes[..valid_len]
-        .strip_suffix(b"\n")
-        .unwrap_or(&bytes[..valid_len]);
-    for (n, line) in complete.split(|&b| b == b'\n').enumerate() {
+    for (n, line) in bytes[..valid_len].split(|&b| b == b'\n').enumerate() {
         if line.iter().all(u8::is_ascii_whitespace) {
             continue;
         }

@@ -931,6 +931,7 @@ fn written_meshes_say_what_they_hold() {
         "{err}"
     );
     let o = run_in(tmp.path(), &args(&["-o", "c.vtu", "--vtu-ascii"]));
+    assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains("ignored"), "{}", stderr(&o));
 }
 
