@@ -74,8 +74,9 @@ pub fn quad_eta(p: [[f64; 3]; 4]) -> f64 {
 
 /// Whether the two triangles of the quad `[s0, o1, s1, o0]` (as for [`quad_eta`]) are bent
 /// over their diagonal by a right angle or more: their normals, in the orientation they share
-/// in the mesh, make an angle of 90 degrees or more (they point away from each other).
-fn folded(p: [[f64; 3]; 4]) -> bool {
+/// in the mesh, make an angle of 90 degrees or more (they point away from each other). In a
+/// plane, the second triangle lies folded back over the first (the two overlap).
+pub fn folded(p: [[f64; 3]; 4]) -> bool {
     use crate::mesh::topology::{cross, dot, sub};
     let [s0, o1, s1, o0] = p;
     let n0 = cross(unit_range(sub(s1, s0)), unit_range(sub(o0, s0)));

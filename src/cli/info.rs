@@ -45,6 +45,10 @@ struct Info {
     /// elements there are not joined, the mesh has a crack (surfaces meshed apart, not
     /// merged). Each node beyond the first at a position counts.
     coincident_nodes: usize,
+    /// Neighbouring triangles (dual-graph edges) whose normals, consistently oriented, are 90
+    /// degrees or more apart: the surface folds back over itself (in a plane, the two
+    /// overlap). 0 on a quad-only file.
+    folded_pairs: usize,
     candidate_pairs: usize,
     /// Candidate pairs whose quad is strictly convex (eta > 0): the actions under the
     /// default rule.
@@ -151,6 +155,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             junction_edges,
             curve_edges: 0,
             coincident_nodes,
+            folded_pairs: 0,
             candidate_pairs: 0,
             valid_pairs: 0,
             reoriented_triangles: 0,
@@ -196,6 +201,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             &m.vertices,
             m.triangles.iter().flatten().chain(m.quads.iter().flatten()),
         ),
+        folded_pairs: (table.quads.iter())
+            .filter(|q| quality::folded(q.map(|v| m.vertices[v as usize])))
+            .count(),
         candidate_pairs: table.len(),
         valid_pairs: (table.eta.iter().zip(&table.quads))
             .filter(|&(&e, q)| Rule::default().allows_pair(e, q.map(|v| m.vertices[v as usize])))
@@ -290,6 +298,15 @@ fn text(i: &Info) -> String {
              not joined, a crack unless meant, e.g. a contact interface; to join them: Gmsh's \
              Coherence Mesh, gmsh.model.mesh.removeDuplicateNodes())",
             i.coincident_nodes
+        );
+    }
+    if i.folded_pairs > 0 {
+        wln!(
+            s,
+            "folded pairs:         {} (neighbouring triangles whose normals are 90 degrees or \
+             more apart: the surface folds back over itself there, or in a plane the two \
+             overlap; a mesh error unless meant; no valid quad is made of them)",
+            i.folded_pairs
         );
     }
     wln!(

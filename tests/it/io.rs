@@ -852,6 +852,90 @@ fn info_counts_coincident_nodes() {
     }
 }
 
+/// `info` counts neighbouring triangles folded over each other (normals 90 degrees or more
+/// apart once oriented consistently): in a plane, a triangle lying back over its neighbour;
+/// on a hinge, a bend past a right angle and not one short of it. The expected counts come
+/// from the coordinates written here (signed areas, the hinge's angle), not from our code.
+#[test]
+fn info_counts_folded_pairs() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+    let write = |name: &str, nodes: &[[f64; 3]], tris: &[[usize; 3]]| {
+        let mut t = format!("{header}$Nodes\n{}\n", nodes.len());
+        for (i, p) in nodes.iter().enumerate() {
+            t += &format!("{} {} {} {}\n", i + 1, p[0], p[1], p[2]);
+        }
+        t += &format!("$EndNodes\n$Elements\n{}\n", tris.len());
+        for (i, v) in tris.iter().enumerate() {
+            t += &format!("{} 2 2 1 1 {} {} {}\n", i + 1, v[0] + 1, v[1] + 1, v[2] + 1);
+        }
+        t += "$EndElements\n";
+        let p = dir.path().join(name);
+        std::fs::write(&p, t).unwrap();
+        p
+    };
+    // A unit square of two triangles; across its right side a triangle whose third node lies
+    // inside the square (folded back over it), across its top one that lies outside. Every
+    // shared side is written in opposite directions by its two triangles (one orientation).
+    let nodes = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.5, 0.4, 0.0],
+        [0.5, 2.0, 0.0],
+    ];
+    let tris = [[0, 1, 2], [0, 2, 3], [2, 1, 4], [3, 2, 5]];
+    let signed = |t: [usize; 3]| {
+        let [a, b, c] = t.map(|v| nodes[v]);
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    };
+    let shares_side =
+        |s: [usize; 3], t: [usize; 3]| s.iter().filter(|v| t.contains(v)).count() == 2;
+    let mut want_plane = 0;
+    for i in 0..tris.len() {
+        for j in i + 1..tris.len() {
+            if shares_side(tris[i], tris[j]) && signed(tris[i]) * signed(tris[j]) < 0.0 {
+                want_plane += 1;
+            }
+        }
+    }
+    assert_eq!(want_plane, 1);
+    let mut cases = vec![(write("plane.msh", &nodes, &tris), want_plane)];
+    // A hinge along the x axis: (0, 0, 0), (1, 0, 0), (0.5, 1, 0) and, across the axis, a
+    // triangle bent up by `bend` degrees (its normal `bend` degrees from the first's).
+    for bend in [80.0f64, 100.0] {
+        let r = bend.to_radians();
+        let hinge = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.5, 1.0, 0.0],
+            [0.5, -r.cos(), r.sin()],
+        ];
+        let p = write(&format!("hinge{bend}.msh"), &hinge, &[[0, 1, 2], [1, 0, 3]]);
+        cases.push((p, usize::from(bend >= 90.0)));
+    }
+    for (path, want) in cases {
+        let out = run_ok(dir.path(), &["info", "--json", path.to_str().unwrap()]);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["folded_pairs"], want, "{}", path.display());
+        let text = run_ok(dir.path(), &["info", path.to_str().unwrap()]);
+        let text = String::from_utf8_lossy(&text.stdout).to_string();
+        let line = format!("folded pairs:         {want} (");
+        assert_eq!(text.contains(&line), want > 0, "{text}");
+    }
+    // Gmsh's and the built-in meshes have none.
+    for mesh in [
+        "borouchaki",
+        "sphere",
+        data("two_squares_41_ascii.msh").to_str().unwrap(),
+    ] {
+        let out = run_ok(dir.path(), &["info", "--json", mesh]);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["folded_pairs"], 0, "{mesh}");
+    }
+}
+
 /// `two_squares_41_ascii.msh` with the header of its second surface's triangle block
 /// (`2 2 2 22`: dimension, entity, type, count) replaced, written to `dir`; and the line.
 fn two_squares_with_block_header(dir: &Path, header: &str) -> (PathBuf, usize) {
