@@ -9,7 +9,7 @@ use std::sync::atomic::AtomicBool;
 use super::ExperimentError;
 use super::events::{Event, Events};
 use super::exec::{Outcome, WorkerFactory, execute};
-use super::manifest::{MANIFEST_FILE, Manifest, OptimumEntry};
+use super::manifest::{MANIFEST_FILE, Manifest, OptimumEntry, Session};
 use super::plan::{Job, execution_order, plan, shard};
 use super::record::{self, RunKey, RunRecord};
 use super::store::{self, RUNS_FILE, RunLog};
@@ -686,8 +686,10 @@ pub fn run(
                     after: shard(plan(&manifest.spec), manifest.shard).len(),
                 });
             }
-            // A merged directory keeps the list of the parts it was made of.
+            // A merged directory keeps the list of the parts it was made of, and every
+            // directory the sweeps that ran its runs so far.
             manifest.merged_from = old.merged_from;
+            manifest.sessions = old.sessions;
         } else if !loaded.records.is_empty() || loaded.torn_bytes > 0 {
             return Err(ExperimentError::AlreadyExists {
                 dir: dir.clone(),
@@ -700,6 +702,8 @@ pub fn run(
             message: format!("{} exists without {MANIFEST_FILE}", RUNS_FILE),
         });
     }
+    // This sweep, after the records there are (a torn last line is cut off before appending).
+    manifest.sessions.push(Session::now(loaded.records.len()));
     // Written whole (a temporary file renamed over the old one), before any new run is
     // appended: a kill leaves either manifest, and the records are a part of the run list of
     // either, which the next --resume completes.
@@ -787,6 +791,7 @@ pub(crate) mod tests {
             threads: 1,
             machine: Machine::current(),
             merged_from: vec![],
+            sessions: vec![],
         }
     }
 

@@ -24,7 +24,7 @@ pub struct Manifest {
     pub backend: String,
     /// The backend asked for on the command line ("auto", "gpu" or "cpu").
     pub backend_requested: String,
-    /// Optimum (exact maximum-weight matching) per mesh, in the order of `spec.meshes`.
+    /// Optimum (exact maximum-weight matching of maximum cardinality) per mesh, in the order of `spec.meshes`.
     pub optimum: Vec<OptimumEntry>,
     /// Which slice of the run list this directory holds; `None` for the whole list.
     pub shard: Option<Shard>,
@@ -35,6 +35,59 @@ pub struct Manifest {
     /// For a merged directory: the shards it was merged from, with their machines.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub merged_from: Vec<MergedPart>,
+    /// The sweeps that ran this directory's runs, in order: the first, then each `--resume`
+    /// or `--extend` (a merge runs none). Empty in directories written before builds were
+    /// recorded (2026-12-05).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sessions: Vec<Session>,
+}
+
+/// One sweep command that ran runs into a directory: which build, when, and from which record
+/// on. Times are comparable only between runs of one build on one machine.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Session {
+    /// The build that ran them ([`super::build`]).
+    pub build: String,
+    /// When the sweep started, UTC (ISO 8601, seconds).
+    pub started: String,
+    /// Records in `runs.jsonl` before it started: its runs are the records from this one
+    /// on, up to the next session's.
+    pub runs_before: usize,
+}
+
+impl Session {
+    /// A session of this build starting now, after `runs_before` records.
+    pub fn now(runs_before: usize) -> Session {
+        let secs = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_secs());
+        Session {
+            build: super::build(),
+            started: utc(secs),
+            runs_before,
+        }
+    }
+}
+
+/// `secs` since the Unix epoch as `YYYY-MM-DDTHH:MM:SSZ` (the proleptic Gregorian calendar:
+/// H. Hinnant's `civil_from_days`).
+pub fn utc(secs: u64) -> String {
+    let (days, rem) = ((secs / 86_400) as i64, secs % 86_400);
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
 }
 
 /// The configuration that decides the run list and the seeds.
@@ -215,6 +268,10 @@ pub struct MergedPart {
     pub machine: Machine,
     /// Records taken from it.
     pub records: usize,
+    /// The builds that ran its runs, in the order of its sessions ([`Session`]); empty
+    /// where they were not recorded.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub builds: Vec<String>,
 }
 
 /// The machine a sweep ran on.
@@ -288,6 +345,17 @@ fn repeated_entry(s: &SweepSpec) -> Option<String> {
 }
 
 impl Manifest {
+    /// The builds of its sessions, each once, in order of first use.
+    pub fn builds(&self) -> Vec<String> {
+        let mut builds: Vec<String> = Vec::new();
+        for s in &self.sessions {
+            if !builds.contains(&s.build) {
+                builds.push(s.build.clone());
+            }
+        }
+        builds
+    }
+
     /// Reads `dir/manifest.json`.
     pub fn read(dir: &Path) -> Result<Manifest, ExperimentError> {
         let path = dir.join(MANIFEST_FILE);
@@ -591,6 +659,38 @@ pub fn spec_difference(a: &SweepSpec, b: &SweepSpec) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Known instants, and GNU `date -u` (where present) on instants around leap days,
+    /// century years and year ends.
+    #[test]
+    fn utc_matches_the_calendar() {
+        for (secs, want) in [
+            (0, "1970-01-01T00:00:00Z"),
+            (951_782_400, "2000-02-29T00:00:00Z"),
+            (1_700_000_000, "2023-11-14T22:13:20Z"),
+            (4_102_444_799, "2099-12-31T23:59:59Z"),
+        ] {
+            assert_eq!(utc(secs), want);
+        }
+        let mut instants: Vec<u64> = (0..200u64).map(|k| k * 21_600_013 + 86_399).collect();
+        instants.extend([951_868_799, 951_868_800, 4_107_542_400, 4_107_542_399]);
+        for secs in instants {
+            let Ok(out) = std::process::Command::new("date")
+                .args(["-u", "-d", &format!("@{secs}"), "+%Y-%m-%dT%H:%M:%SZ"])
+                .output()
+            else {
+                return;
+            };
+            if !out.status.success() {
+                return;
+            }
+            assert_eq!(
+                utc(secs),
+                String::from_utf8_lossy(&out.stdout).trim(),
+                "{secs}"
+            );
+        }
+    }
 
     #[test]
     fn dropped_runs_and_union() {

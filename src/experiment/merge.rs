@@ -184,6 +184,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
             shard: m.shard,
             machine: m.machine.clone(),
             records: loaded.records.len(),
+            builds: m.builds(),
         });
     }
     let missing: Vec<RunKey> = jobs
@@ -235,6 +236,8 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<Merged, ExperimentError> {
     manifest.threads = manifests.iter().map(|m| m.threads).max().unwrap_or(1);
     manifest.machine = super::manifest::Machine::current();
     manifest.merged_from = merged_from;
+    // The merge runs nothing; its parts' builds are in `merged_from`.
+    manifest.sessions = Vec::new();
     manifest.write(out)?;
     // The runs whole or not at all (a full disk leaves no runs, and the merge can be done
     // again): the manifest alone is a sweep with no runs yet.

@@ -202,3 +202,19 @@ pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExperimentEr
 
 /// Version recorded in records and manifests.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// This binary's build, as a manifest's [`manifest::Session`] records it: the version, the git
+/// commit it was built from (`+modified` where the tracked sources differed from it; `unknown`
+/// outside a git checkout), and `debug assertions` for a build with them (whose times are
+/// not an optimised build's).
+pub fn build() -> String {
+    format!(
+        "quadrecomb {VERSION}, git {}{}",
+        env!("QUADRECOMB_BUILD"),
+        if cfg!(debug_assertions) {
+            ", debug assertions"
+        } else {
+            ""
+        }
+    )
+}

@@ -156,6 +156,7 @@ pub fn prepare(config: &SweepConfig, events: &mut Events<'_>) -> Result<Prepared
         threads: config.threads(),
         machine: Machine::current(),
         merged_from: Vec::new(),
+        sessions: Vec::new(),
     };
     Ok(Prepared {
         meshes,

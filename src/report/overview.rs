@@ -70,7 +70,18 @@ pub(super) fn overview(doc: &mut Document, results: &Results) {
             let parts: Vec<String> = m
                 .merged_from
                 .iter()
-                .map(|p| format!("{} ({} runs): {}", p.dir, p.records, machine(&p.machine)))
+                .map(|p| {
+                    let builds = match p.builds.as_slice() {
+                        [] => "build not recorded".to_string(),
+                        b => format!("build {}", b.join(" then ")),
+                    };
+                    format!(
+                        "{} ({} runs): {}, {builds}",
+                        p.dir,
+                        p.records,
+                        machine(&p.machine)
+                    )
+                })
                 .collect();
             doc.para(format!(
                 "Merged from shards run on: {}. Base seed {}.",
@@ -78,6 +89,7 @@ pub(super) fn overview(doc: &mut Document, results: &Results) {
                 m.spec.seed
             ));
         }
+        doc.para(builds(m, results.num_runs()));
     }
     if results.torn_bytes > 0 {
         doc.para(
@@ -94,6 +106,51 @@ pub(super) fn overview(doc: &mut Document, results: &Results) {
         })
         .collect();
     doc.para(format!("Configurations: {}.", labels.join("; ")));
+}
+
+/// Which build ran which records ([`crate::experiment::manifest::Session`]), and that times
+/// compare only within one build and machine.
+pub(crate) fn builds(m: &crate::experiment::manifest::Manifest, records: usize) -> String {
+    const CAVEAT: &str = "Times are of that build on that machine: compare them only with \
+                          times of the same build and machine.";
+    // Consecutive sessions of one build, as (build, first session's start, first record).
+    let mut spans: Vec<(&str, &str, usize)> = Vec::new();
+    for s in &m.sessions {
+        if spans.last().is_none_or(|l| l.0 != s.build) {
+            spans.push((&s.build, &s.started, s.runs_before));
+        }
+    }
+    match spans.as_slice() {
+        [] if m.merged_from.is_empty() => format!(
+            "Build: not recorded (written before quadrecomb recorded its builds, 2026-12-05). \
+             {CAVEAT}"
+        ),
+        [] => CAVEAT.to_string(),
+        [(build, started, _)] => {
+            let resumed = m.sessions.len() - 1;
+            let resumed = match resumed {
+                0 => String::new(),
+                1 => ", resumed once".to_string(),
+                n => format!(", resumed {n} times"),
+            };
+            format!("Build: {build} (sweep started {started}{resumed}). {CAVEAT}")
+        }
+        spans => {
+            let parts: Vec<String> = spans
+                .iter()
+                .enumerate()
+                .map(|(i, &(build, started, first))| {
+                    let end = spans.get(i + 1).map_or(records, |n| n.2);
+                    format!("records {}–{end} by {build} (started {started})", first + 1)
+                })
+                .collect();
+            format!(
+                "Builds: {}. Runs of different builds are mixed here: their times are not \
+                 comparable with each other. {CAVEAT}",
+                parts.join("; ")
+            )
+        }
+    }
 }
 
 /// The runs recorded and the runs this directory's manifest plans (its shard's, for a

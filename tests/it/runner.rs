@@ -253,6 +253,103 @@ fn torn_last_line_is_redone_on_resume_and_fresh_sweep_refuses_a_used_dir() {
     assert!(stderr(&other).contains("runs 5 vs 4"), "{}", stderr(&other));
 }
 
+/// The manifest records each sweep that ran runs into a directory: the build (this checkout's
+/// git commit), the start (checked against `date -u`) and the records before it; the report
+/// names the build, says when builds are mixed (which records each ran), and says when the
+/// build was not recorded.
+#[test]
+fn manifest_records_each_sweeps_build_and_the_report_says_which_ran_what() {
+    use serde_json::Value;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mesh = small_mesh(dir, 600);
+    let args = sweep_args(&mesh, "out", 4, "1..3");
+    let minute = || {
+        let out = Command::new("date")
+            .args(["-u", "+%Y-%m-%dT%H:%M"])
+            .output()
+            .unwrap();
+        String::from_utf8(out.stdout).unwrap().trim().to_string()
+    };
+    let before = minute();
+    assert!(sweep(dir, &args, &[]).status.success());
+    let after = minute();
+    let manifest = |d: &Path| -> Value {
+        serde_json::from_str(&std::fs::read_to_string(d.join("out/manifest.json")).unwrap())
+            .unwrap()
+    };
+    let m = manifest(dir);
+    let sessions = m["sessions"].as_array().unwrap();
+    assert_eq!(sessions.len(), 1, "{m}");
+    let build = sessions[0]["build"].as_str().unwrap().to_string();
+    assert!(build.starts_with("quadrecomb 0.1.0, git "), "{build}");
+    let head = Command::new("git")
+        .args(["rev-parse", "--short=12", "HEAD"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .ok()
+        .filter(|o| o.status.success());
+    if let Some(head) = head {
+        let head = String::from_utf8(head.stdout).unwrap();
+        assert!(build.contains(head.trim()), "{build} vs HEAD {head}");
+    }
+    let started = sessions[0]["started"].as_str().unwrap();
+    assert!(
+        (started.starts_with(&before) || started.starts_with(&after)) && started.ends_with('Z'),
+        "{started} vs date -u {before} .. {after}"
+    );
+    assert_eq!(sessions[0]["runs_before"], 0);
+
+    // Cut the log to its first `kept` records and resume: a second session after them.
+    let runs = dir.join("out/runs.jsonl");
+    let text = std::fs::read_to_string(&runs).unwrap();
+    let total = text.lines().count();
+    let kept = total - 3;
+    let head: Vec<&str> = text.lines().take(kept).collect();
+    std::fs::write(&runs, head.join("\n") + "\n").unwrap();
+    assert!(sweep(dir, &args, &["--resume"]).status.success());
+    let m = manifest(dir);
+    let sessions = m["sessions"].as_array().unwrap();
+    assert_eq!(sessions.len(), 2, "{m}");
+    assert_eq!(sessions[1]["runs_before"], kept);
+    assert_eq!(sessions[1]["build"], build.as_str());
+
+    let report = |d: &Path| {
+        let out = run_in(d, &["report", "out"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        std::fs::read_to_string(d.join("out/report.md")).unwrap()
+    };
+    let text = report(dir);
+    assert!(
+        text.contains(&format!(
+            "Build: {build} (sweep started {started}, resumed once)"
+        )),
+        "{text}"
+    );
+    assert!(
+        text.contains("compare them only with times of the same build"),
+        "{text}"
+    );
+
+    // The first sweep's build made another: the report says which records each ran.
+    let mut m = manifest(dir);
+    m["sessions"][0]["build"] = "quadrecomb 0.0.9, git 000000000000".into();
+    std::fs::write(dir.join("out/manifest.json"), m.to_string()).unwrap();
+    let text = report(dir);
+    let want = format!(
+        "Builds: records 1–{kept} by quadrecomb 0.0.9, git 000000000000 (started {started}); \
+         records {}–{total} by {build}",
+        kept + 1
+    );
+    assert!(text.contains(&want), "{want}\n{text}");
+    assert!(text.contains("their times are not comparable"), "{text}");
+
+    // A directory written before builds were recorded.
+    m.as_object_mut().unwrap().remove("sessions");
+    std::fs::write(dir.join("out/manifest.json"), m.to_string()).unwrap();
+    assert!(report(dir).contains("Build: not recorded"));
+}
+
 #[test]
 fn overwrite_replaces_an_earlier_sweep_with_another_configuration() {
     let tmp = tempfile::tempdir().unwrap();

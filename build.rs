@@ -1,0 +1,43 @@
+//! Build identity for the sweeps' manifests: `QUADRECOMB_BUILD` is the git commit this
+//! binary was built from, with `+modified` when tracked sources differ from it, or
+//! `unknown` outside a git checkout (a crate from a registry or a tarball). A sweep records
+//! it, so that timings are never compared across builds unawares.
+
+use std::path::Path;
+use std::process::Command;
+
+fn main() {
+    let git = |args: &[&str]| {
+        Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    // Rebuilt when the sources or the checked-out commit change (not on every file of the
+    // package, such as a sweep's results).
+    for path in ["src", "shaders", "Cargo.toml", "Cargo.lock", "build.rs"] {
+        println!("cargo:rerun-if-changed={path}");
+    }
+    if let Some(dir) = git(&["rev-parse", "--git-dir"]) {
+        let dir = Path::new(&dir);
+        for file in ["HEAD", "index", "packed-refs"] {
+            println!("cargo:rerun-if-changed={}", dir.join(file).display());
+        }
+        if let Some(head) = git(&["symbolic-ref", "-q", "HEAD"]) {
+            println!("cargo:rerun-if-changed={}", dir.join(head).display());
+        }
+    }
+    let build = match git(&["rev-parse", "--short=12", "HEAD"]) {
+        Some(commit) => {
+            let sources = ["src", "shaders", "Cargo.toml", "Cargo.lock", "build.rs"];
+            let mut args = vec!["status", "--porcelain", "--untracked-files=no", "--"];
+            args.extend(sources);
+            let modified = git(&args).is_none_or(|s| !s.is_empty());
+            format!("{commit}{}", if modified { "+modified" } else { "" })
+        }
+        None => "unknown".to_string(),
+    };
+    println!("cargo:rustc-env=QUADRECOMB_BUILD={build}");
+}
