@@ -271,8 +271,15 @@ fn record(results: &Results, m: &Medians<'_>, j: usize, base: usize, seed: u64) 
             (true, std::cmp::Ordering::Less) => Verdict::Loss,
             _ => Verdict::Tie,
         };
+        // Equal medians on a significant difference: the rest of the runs differ (A says
+        // how often the first is ahead), which a reader would not guess from the medians.
+        let equal = if format!("{a:.2}") == format!("{b:.2}") && v != Verdict::Tie {
+            "; the medians are equal, the test and A compare all the runs"
+        } else {
+            ""
+        };
         let what = format!(
-            "{a:.2} vs {b:.2}, A = {av:.2}, Holm p = {}",
+            "{a:.2} vs {b:.2}, A = {av:.2}, Holm p = {}{equal}",
             fmt_p(p.cmp.p_holm)
         );
         verdicts.push((index(&p.first), p.first.clone(), v, what));

@@ -21,10 +21,21 @@ use plotters::prelude::*;
 /// Per configuration: median nodes per decision, median time, and quality q1 / median / q3.
 struct Point {
     label: String,
-    algo: String,
+    /// The figure's line it is on: the method, and the horizon for a budgeted one.
+    line: String,
     nodes: f64,
     time: f64,
     q: [f64; 3],
+}
+
+/// The line of a quality-against-budget figure that `c` is on: one per method, and per
+/// horizon for a budgeted method (its budget is the x axis; a change of horizon is another
+/// line, not a step along it).
+pub(super) fn line_of(c: &Config) -> String {
+    match c.budget {
+        Some(_) => format!("{} h={}", c.algo, c.horizon.unwrap_or(0)),
+        None => c.algo.clone(),
+    }
 }
 
 fn point(c: &Config, runs: &[Run]) -> Point {
@@ -36,7 +47,7 @@ fn point(c: &Config, runs: &[Run]) -> Point {
     let time: Vec<f64> = runs.iter().map(|r| r.time_s).collect();
     Point {
         label: c.label(),
-        algo: c.algo.clone(),
+        line: line_of(c),
         nodes: median(&nodes),
         time: median(&time),
         q: [quantile(&q, 0.25), median(&q), quantile(&q, 0.75)],
@@ -115,8 +126,9 @@ fn node_budgets(
         svg,
         format!(
             "{mesh}: {name} against the median tree nodes expanded per decision (log axis), \
-             one line per method (selective: one point per horizon; the others one per \
-             budget); dots at the medians, bars from the first to the third quartile."
+             one line per method and horizon for the budgeted methods (one point per budget), \
+             one line for selective (one point per horizon); dots at the medians, bars from \
+             the first to the third quartile."
         ),
     );
     // Each budgeted configuration against the cheapest selective horizon at least as slow.
@@ -157,27 +169,31 @@ fn node_budgets(
     Ok(())
 }
 
-/// Colours of the lines, by method (in order of appearance).
-const COLORS: [RGBColor; 6] = [
+/// Colours of the lines, in the order of their labels (methods, and horizons of the
+/// budgeted ones): selective and three policies at two horizons fit.
+pub(super) const COLORS: [RGBColor; 8] = [
     RGBColor(220, 20, 20),
     RGBColor(20, 60, 170),
     RGBColor(20, 140, 60),
     RGBColor(150, 60, 170),
     RGBColor(230, 130, 0),
     RGBColor(90, 90, 90),
+    RGBColor(0, 170, 190),
+    RGBColor(170, 110, 40),
 ];
 
-/// The figure: one line per method through its configurations' medians, IQR bars.
+/// The figure: one line per method (and horizon, for the budgeted ones) through its
+/// configurations' medians, IQR bars.
 fn figure(mesh: &str, name: &str, points: &[Point]) -> Result<String, ReportError> {
-    let mut algos: Vec<&str> = points.iter().map(|p| p.algo.as_str()).collect();
-    algos.sort_unstable();
-    algos.dedup();
-    let lines: Vec<Line> = (algos.iter())
-        .map(|algo| {
-            let mut mine: Vec<&Point> = points.iter().filter(|p| p.algo == *algo).collect();
+    let mut labels: Vec<&str> = points.iter().map(|p| p.line.as_str()).collect();
+    labels.sort_unstable();
+    labels.dedup();
+    let lines: Vec<Line> = (labels.iter())
+        .map(|label| {
+            let mut mine: Vec<&Point> = points.iter().filter(|p| p.line == *label).collect();
             mine.sort_by(|a, b| a.nodes.total_cmp(&b.nodes));
             let pts = mine.iter().map(|p| (p.nodes.max(1.0), p.q)).collect();
-            (algo.to_string(), pts)
+            (label.to_string(), pts)
         })
         .collect();
     lines_figure(
@@ -185,7 +201,6 @@ fn figure(mesh: &str, name: &str, points: &[Point]) -> Result<String, ReportErro
         "tree nodes expanded per decision (median)",
         name,
         &lines,
-        &COLORS,
     )
 }
 
@@ -193,15 +208,37 @@ fn figure(mesh: &str, name: &str, points: &[Point]) -> Result<String, ReportErro
 /// each `(x, [q1, median, q3])`.
 pub(super) type Line = (String, Vec<(f64, [f64; 3])>);
 
-/// Quality against a budget on a log x axis: one coloured line of medians per [`Line`], with
-/// its points and interquartile bars (the node-budget and the time-budget figures).
+/// Ticks of the log x axis over `[lo, hi]`: 1, 2 and 5 times the powers of ten, or every
+/// digit times them where that gives fewer than two, or the ends themselves.
+fn x_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let ticks = super::plots::log_ticks(lo, hi);
+    if ticks.len() >= 2 {
+        return ticks;
+    }
+    let mut out = Vec::new();
+    let mut p = 10f64.powi(lo.log10().floor() as i32);
+    while p <= hi {
+        out.extend(
+            (1..10)
+                .map(|d| d as f64 * p)
+                .filter(|v| (lo..=hi).contains(v)),
+        );
+        p *= 10.0;
+    }
+    if out.len() >= 2 { out } else { vec![lo, hi] }
+}
+
+/// Quality against a budget on a log x axis: one coloured line of medians per [`Line`] (in
+/// the colours of [`COLORS`]), with its points and interquartile bars (the node-budget and
+/// the time-budget figures). The title and the legend (two columns) sit above the plot,
+/// never over the data; the x axis is labelled at [`x_ticks`].
 pub(super) fn lines_figure(
     title: &str,
     x_desc: &str,
     name: &str,
     lines: &[Line],
-    colors: &[RGBColor],
 ) -> Result<String, ReportError> {
+    use super::plots::{LEGEND_ROW, SIZE, TITLE, format_tick};
     let points = || lines.iter().flat_map(|(_, pts)| pts.iter());
     let xs = points().map(|p| p.0);
     let (xmin, xmax) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
@@ -210,36 +247,70 @@ pub(super) fn lines_figure(
         (a.min(y), b.max(y))
     });
     let pad = ((ymax - ymin) * 0.08).max(1e-3);
+    let (x_lo, x_hi) = (xmin / 1.25, xmax * 1.25);
+    let color = |i: usize| COLORS[i % COLORS.len()];
+    let rows = lines.len().div_ceil(2) as u32;
+    let top = TITLE + LEGEND_ROW * rows + 6;
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, super::plots::SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (SIZE.0, SIZE.1 + top)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
+        let (head, body) = root.split_vertically(top);
+        let (w, _) = head.dim_in_pixel();
+        let centred = TextStyle::from(("sans-serif", 20).into_font()).pos(
+            plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Center,
+                plotters::style::text_anchor::VPos::Top,
+            ),
+        );
+        head.draw(&Text::new(title.to_string(), (w as i32 / 2, 8), centred))
+            .map_err(plot_err)?;
+        for (i, (label, _)) in lines.iter().enumerate() {
+            let x = 80 + (i % 2) as i32 * (w as i32 - 80) / 2;
+            let y = (TITLE + LEGEND_ROW * (i / 2) as u32 + LEGEND_ROW / 2) as i32;
+            head.draw(&PathElement::new(
+                vec![(x, y), (x + 24, y)],
+                color(i).stroke_width(2),
+            ))
+            .map_err(plot_err)?;
+            head.draw(&Circle::new((x + 12, y), 3, color(i).filled()))
+                .map_err(plot_err)?;
+            head.draw(&Text::new(
+                label.clone(),
+                (x + 32, y - 8),
+                ("sans-serif", 16).into_font(),
+            ))
+            .map_err(plot_err)?;
+        }
+        let mut chart = ChartBuilder::on(&body)
             .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
+            .margin_top(4)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
             .build_cartesian_2d(
-                ((xmin / 1.5)..(xmax * 1.5)).log_scale(),
+                (x_lo..x_hi)
+                    .log_scale()
+                    .with_key_points(x_ticks(x_lo, x_hi)),
                 (ymin - pad)..(ymax + pad),
             )
             .map_err(plot_err)?;
         chart
             .configure_mesh()
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(BLACK.mix(0.12))
+            .x_label_formatter(&|x| format_tick(*x))
             .x_desc(x_desc)
             .y_desc(name)
             .draw()
             .map_err(plot_err)?;
-        for (i, (label, pts)) in lines.iter().enumerate() {
-            let color = colors[i % colors.len()];
+        for (i, (_, pts)) in lines.iter().enumerate() {
+            let color = color(i);
             chart
                 .draw_series(LineSeries::new(
                     pts.iter().map(|&(x, q)| (x, q[1])),
                     color.stroke_width(2),
                 ))
-                .map_err(plot_err)?
-                .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color));
+                .map_err(plot_err)?;
             chart
                 .draw_series(pts.iter().map(|&(x, q)| {
                     PathElement::new(vec![(x, q[0]), (x, q[2])], color.stroke_width(1))
@@ -252,13 +323,6 @@ pub(super) fn lines_figure(
                 )
                 .map_err(plot_err)?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::LowerRight)
-            .draw()
-            .map_err(plot_err)?;
         root.present().map_err(plot_err)?;
     }
     Ok(svg)

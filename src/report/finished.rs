@@ -64,10 +64,7 @@ pub(super) fn table_rows(summary: &Summary, configs: &[(&Config, &[Run])]) -> Ve
             b.filter(|b| b.n == g.n).map(|b| b.median)
         };
         rows.push(vec![
-            match c.budget {
-                Some(b) => format!("{} b={b} + finish", c.algo),
-                None => format!("{} + finish", c.algo),
-            },
+            format!("{} + finish", super::mesh_section::row_name(c)),
             c.horizon.map_or("–".into(), |h| h.to_string()),
             g.n.to_string(),
             pct(whole(g.quality_pct.as_ref()), refined(runs)),

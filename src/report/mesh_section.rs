@@ -21,6 +21,19 @@ pub(super) fn optimum_of(results: &Results, mesh: &str) -> Option<f64> {
         .map(|o| o.quality)
 }
 
+/// A configuration's name in the first column of a table that gives the horizon in the
+/// second: the algorithm, its node budget and the time budget it was calibrated to.
+pub(super) fn row_name(c: &Config) -> String {
+    let mut name = match c.budget {
+        Some(b) => format!("{} b={b}", c.algo),
+        None => c.algo.clone(),
+    };
+    if let Some(t) = c.time_budget {
+        name += &format!(" (T={}s)", t.seconds());
+    }
+    name
+}
+
 /// One table row per configuration: its algorithm and horizon ("–" for none), then the
 /// `cells` of its runs.
 fn config_rows(
@@ -29,13 +42,7 @@ fn config_rows(
 ) -> Vec<Vec<String>> {
     (configs.iter())
         .map(|(c, runs)| {
-            let mut row = vec![
-                match c.budget {
-                    Some(b) => format!("{} b={b}", c.algo),
-                    None => c.algo.clone(),
-                },
-                c.horizon.map_or("–".into(), |h| h.to_string()),
-            ];
+            let mut row = vec![row_name(c), c.horizon.map_or("–".into(), |h| h.to_string())];
             row.extend(cells(c, runs));
             row
         })
@@ -53,8 +60,9 @@ pub(super) fn mesh_section(
 ) -> Result<(), ReportError> {
     let every: Vec<(&Config, &[Run])> = results.configs_of(mesh).collect();
     let first = &every[0].1[0];
-    // The budgeted configurations have their own section (quality against budget); the
-    // horizon sections below read the others.
+    // Tables 1 and the element quality list every configuration; the budgeted ones also have
+    // their own section (quality against budget), and the horizon sections below (box
+    // plots, the paper's numbers, pictures, tests between horizons) read the others.
     let configs: Vec<(&Config, &[Run])> = (every.iter().copied())
         .filter(|(c, _)| c.budget.is_none() && c.time_budget.is_none())
         .collect();
@@ -66,7 +74,10 @@ pub(super) fn mesh_section(
     doc.heading(2, format!("Mesh {mesh}"));
     let opt = optimum_of(results, mesh);
     doc.para(format!(
-        "{} triangles (mesh hash {}). Optimum quality (maximum-weight matching): {}.",
+        "{} triangles (mesh hash {}). Optimum quality: {} (the maximum-weight matching among \
+         those of maximum cardinality, docs/optimum.md). Quality % is of it, so a run that \
+         leaves more triangles can pass 100 % (a heavier set of fewer quads): read it beside \
+         recombined %.",
         first.triangles,
         &first.mesh_hash[..first.mesh_hash.len().min(16)],
         opt.map_or("not recorded".to_string(), |q| format!("{q:.4}")),
@@ -74,7 +85,7 @@ pub(super) fn mesh_section(
 
     // Table 1.
     doc.heading(3, "Results (medians)");
-    let rows = config_rows(&configs, |c, runs| {
+    let rows = config_rows(&every, |c, runs| {
         vec![
             runs.len().to_string(),
             fmt_opt(median_of(summary, c, |g| g.quality_pct.as_ref()), 2),
@@ -93,7 +104,7 @@ pub(super) fn mesh_section(
         ]
     });
     let mut rows = rows;
-    rows.extend(super::finished::table_rows(summary, &configs));
+    rows.extend(super::finished::table_rows(summary, &every));
     doc.table(
         [
             "algorithm",
@@ -121,13 +132,13 @@ pub(super) fn mesh_section(
          decisions are unchanged), and its time grows more slowly with the horizon.",
     );
 
-    if super::finished::any_refined(&configs) {
+    if super::finished::any_refined(&every) {
         doc.para(super::finished::refined_note());
     }
     // Every finished configuration, the budgeted and time-budget ones included: their own
     // sections show no finish.
     super::finished::what_it_added(doc, summary, &every);
-    element_table(doc, summary, &configs);
+    element_table(doc, summary, &every);
     greedy_paradox(doc, &configs);
     super::beside_paper::paper_beside(doc, summary, mesh, &configs);
     super::box_plots::box_plots(doc, summary, mesh, &configs)?;

@@ -46,9 +46,9 @@ pub struct Extras {
 }
 
 /// Height of one legend row above the plot, in pixels.
-const LEGEND_ROW: u32 = 24;
+pub(super) const LEGEND_ROW: u32 = 24;
 /// Height of the title above the legend.
-const TITLE: u32 = 38;
+pub(super) const TITLE: u32 = 38;
 
 /// One legend row: the colour of its dashed line sample, and the text.
 struct LegendEntry {
@@ -141,7 +141,7 @@ pub fn boxplot_svg(
 
 /// Ticks of a log axis over `[lo, hi]`: 1, 2 and 5 times the powers of ten, or only the powers
 /// when the axis spans more than three decades.
-fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+pub(super) fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let decades = (hi / lo).log10();
     let steps: &[f64] = if decades > 3.0 {
         &[1.0]
@@ -363,7 +363,7 @@ where
 }
 
 /// Tick label: up to 4 significant digits, no trailing zeros.
-fn format_tick(v: f64) -> String {
+pub(super) fn format_tick(v: f64) -> String {
     if v == 0.0 {
         return "0".into();
     }

@@ -5,14 +5,13 @@
 //! Holm, A12, bootstrap interval, as the report's other comparisons).
 
 use super::ReportError;
-use super::budget::{Line, lines_figure};
+use super::budget::{Line, line_of, lines_figure};
 use super::document::Document;
 use super::format::fmt_sig;
 use super::results::{Config, Metric, Run};
 use super::significance::Family;
 use crate::experiment::calibrate::{TimeBudget, has_knob};
 use crate::stats::describe::{median, quantile};
-use plotters::prelude::*;
 
 /// One configuration calibrated to a time budget.
 struct Row<'a> {
@@ -160,26 +159,10 @@ pub(super) fn time_budgets(
     Ok(())
 }
 
-/// Colours of the lines (methods, and horizons of the budgeted ones), in order: one more
-/// line than the node-budget figure has (selective and three policies at two horizons).
-const COLORS: [RGBColor; 8] = [
-    RGBColor(220, 20, 20),
-    RGBColor(20, 60, 170),
-    RGBColor(20, 140, 60),
-    RGBColor(150, 60, 170),
-    RGBColor(230, 130, 0),
-    RGBColor(90, 90, 90),
-    RGBColor(0, 170, 190),
-    RGBColor(170, 110, 40),
-];
-
 /// The figure: quality against the time budget, one line per method (and horizon, for the
 /// budgeted methods), IQR bars.
 fn figure(mesh: &str, name: &str, rows: &[Row<'_>]) -> Result<String, ReportError> {
-    let line_of = |r: &Row<'_>| match r.config.budget {
-        Some(_) => format!("{} h={}", r.config.algo, r.config.horizon.unwrap_or(0)),
-        None => r.config.algo.clone(),
-    };
+    let line_of = |r: &Row<'_>| line_of(r.config);
     let mut labels: Vec<String> = rows.iter().map(line_of).collect();
     labels.sort_unstable();
     labels.dedup();
@@ -196,6 +179,5 @@ fn figure(mesh: &str, name: &str, rows: &[Row<'_>]) -> Result<String, ReportErro
         "time budget per run (s)",
         name,
         &lines,
-        &COLORS,
     )
 }

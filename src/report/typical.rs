@@ -39,7 +39,7 @@ pub fn rerun<'a>(replayer: &'a mut Replayer<'_>, run: &Run) -> Result<Typical<'a
     // The optimum has no seed to re-run from: its matching is computed again.
     if !crate::experiment::record::is_search(&run.algo) {
         let note = format!(
-            "optimum (maximum-weight matching): {} quads, {} triangles left, quality {:.4}. \
+            "optimum (maximum-weight matching of maximum cardinality): {} quads, {} triangles left, quality {:.4}. \
              Matching computed again with eta from {}; {verdict}.",
             out.quads,
             out.triangles_left,

@@ -447,6 +447,7 @@ fn synthetic_manifest(dir: &Path, runs: u32) {
             host: "h".into(),
         },
         merged_from: Vec::new(),
+        sessions: Vec::new(),
     }
     .write(dir)
     .unwrap();
@@ -530,7 +531,7 @@ fn report_names_every_configuration_and_draws_every_box() {
         "{md}"
     );
     assert!(
-        md.contains("Optimum quality (maximum-weight matching): 950.0000"),
+        md.contains("Optimum quality: 950.0000 (the maximum-weight matching among those of maximum cardinality"),
         "{md}"
     );
     let html = std::fs::read_to_string(&paths.html).unwrap();
@@ -1211,8 +1212,9 @@ fn optimum_pictured_stale_figures_removed_no_tree_is_a_dash() {
     assert!(polygons(&svg) > 400, "the optimum's quads are drawn");
     let md = std::fs::read_to_string(d.join("report.md")).unwrap();
     assert!(
-        md.contains("optimum (maximum-weight matching): 1052 quads, 0 triangles left")
-            && md.contains("Matching computed again with eta from")
+        md.contains(
+            "optimum (maximum-weight matching of maximum cardinality): 1052 quads, 0 triangles left"
+        ) && md.contains("Matching computed again with eta from")
             && md.contains("reproduces the recorded quads and quality exactly"),
         "{md}"
     );
