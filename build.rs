@@ -7,8 +7,11 @@ use std::path::Path;
 use std::process::Command;
 
 fn main() {
+    // `--no-optional-locks`: `git status` must not refresh the index, whose change would
+    // make the next build run this script (and rebuild the crate) again, and so on.
     let git = |args: &[&str]| {
         Command::new("git")
+            .arg("--no-optional-locks")
             .args(args)
             .output()
             .ok()
@@ -16,13 +19,14 @@ fn main() {
             .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
     };
     // Rebuilt when the sources or the checked-out commit change (not on every file of the
-    // package, such as a sweep's results).
+    // package, such as a sweep's results). Staging changes nothing that counts: a staged
+    // change is a modification as an unstaged one is, until the commit moves the branch.
     for path in ["src", "shaders", "Cargo.toml", "Cargo.lock", "build.rs"] {
         println!("cargo:rerun-if-changed={path}");
     }
     if let Some(dir) = git(&["rev-parse", "--git-dir"]) {
         let dir = Path::new(&dir);
-        for file in ["HEAD", "index", "packed-refs"] {
+        for file in ["HEAD", "packed-refs"] {
             println!("cargo:rerun-if-changed={}", dir.join(file).display());
         }
         if let Some(head) = git(&["symbolic-ref", "-q", "HEAD"]) {

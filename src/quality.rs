@@ -84,6 +84,23 @@ pub fn folded(p: [[f64; 3]; 4]) -> bool {
     dot(unit_range(n0), unit_range(n1)) <= 0.0
 }
 
+/// The cosine of the angle between the normals of the two triangles of the quad `[s0, o1,
+/// s1, o0]` (as for [`quad_eta`]), in the orientation they share in the mesh: 1 flat, 0 at a
+/// right angle, -1 folded flat back over each other.
+pub fn normals_cos(p: [[f64; 3]; 4]) -> f64 {
+    use crate::mesh::topology::{cross, dot, sub};
+    let [s0, o1, s1, o0] = p;
+    let n0 = cross(unit_range(sub(s1, s0)), unit_range(sub(o0, s0)));
+    let n1 = cross(unit_range(sub(s0, s1)), unit_range(sub(o1, s1)));
+    let (n0, n1) = (unit_range(n0), unit_range(n1));
+    let scale = crate::mesh::topology::norm(n0) * crate::mesh::topology::norm(n1);
+    if scale > 0.0 {
+        dot(n0, n1) / scale
+    } else {
+        1.0
+    }
+}
+
 /// eta of a quad given as a cycle of four corners, as a mesh file holds it: eq. 1 on its four
 /// corner angles (the angle between the two sides meeting at each corner), whichever diagonal
 /// a writer had in mind. A corner that turns against the quad's orientation (a reflex corner,

@@ -45,9 +45,9 @@ struct Info {
     /// elements there are not joined, the mesh has a crack (surfaces meshed apart, not
     /// merged). Each node beyond the first at a position counts.
     coincident_nodes: usize,
-    /// Neighbouring triangles (dual-graph edges) whose normals, consistently oriented, are 90
-    /// degrees or more apart: the surface folds back over itself (in a plane, the two
-    /// overlap). 0 on a quad-only file.
+    /// Neighbouring triangles of one surface (dual-graph edges) whose normals, consistently
+    /// oriented, are more than 150 degrees apart: the surface folds back over itself (in a
+    /// plane, the two overlap), or a knife edge. 0 on a quad-only file.
     folded_pairs: usize,
     candidate_pairs: usize,
     /// Candidate pairs whose quad is strictly convex (eta > 0): the actions under the
@@ -201,8 +201,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             &m.vertices,
             m.triangles.iter().flatten().chain(m.quads.iter().flatten()),
         ),
+        // More than 150 degrees: a fold, not the right-angle edge of a box meshed as one
+        // surface (a coarse cylinder's 120 degrees neither).
         folded_pairs: (table.quads.iter())
-            .filter(|q| quality::folded(q.map(|v| m.vertices[v as usize])))
+            .filter(|q| quality::normals_cos(q.map(|v| m.vertices[v as usize])) < -0.866_025_4)
             .count(),
         candidate_pairs: table.len(),
         valid_pairs: (table.eta.iter().zip(&table.quads))
@@ -303,9 +305,10 @@ fn text(i: &Info) -> String {
     if i.folded_pairs > 0 {
         wln!(
             s,
-            "folded pairs:         {} (neighbouring triangles whose normals are 90 degrees or \
-             more apart: the surface folds back over itself there, or in a plane the two \
-             overlap; a mesh error unless meant; no valid quad is made of them)",
+            "folded pairs:         {} (neighbouring triangles whose normals are more than 150 \
+             degrees apart: the surface folds back over itself there, or in a plane the two \
+             overlap; a mesh error unless meant, as a knife edge can be; no valid quad is made \
+             of them)",
             i.folded_pairs
         );
     }

@@ -346,8 +346,15 @@ fn repeated_entry(s: &SweepSpec) -> Option<String> {
 
 impl Manifest {
     /// The builds of its sessions, each once, in order of first use.
+    /// A merged directory's parts' builds come first, so that a merge of merged directories
+    /// keeps them.
     pub fn builds(&self) -> Vec<String> {
         let mut builds: Vec<String> = Vec::new();
+        for b in self.merged_from.iter().flat_map(|p| &p.builds) {
+            if !builds.contains(b) {
+                builds.push(b.clone());
+            }
+        }
         for s in &self.sessions {
             if !builds.contains(&s.build) {
                 builds.push(s.build.clone());

@@ -170,8 +170,8 @@ fn node_budgets(
 }
 
 /// Colours of the lines, in the order of their labels (methods, and horizons of the
-/// budgeted ones): selective and three policies at two horizons fit.
-pub(super) const COLORS: [RGBColor; 8] = [
+/// budgeted ones): selective and three policies at three horizons fit.
+pub(super) const COLORS: [RGBColor; 12] = [
     RGBColor(220, 20, 20),
     RGBColor(20, 60, 170),
     RGBColor(20, 140, 60),
@@ -180,6 +180,10 @@ pub(super) const COLORS: [RGBColor; 8] = [
     RGBColor(90, 90, 90),
     RGBColor(0, 170, 190),
     RGBColor(170, 110, 40),
+    RGBColor(240, 120, 170),
+    RGBColor(120, 170, 30),
+    RGBColor(0, 0, 0),
+    RGBColor(100, 150, 230),
 ];
 
 /// The figure: one line per method (and horizon, for the budgeted ones) through its

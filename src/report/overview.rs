@@ -109,46 +109,110 @@ pub(super) fn overview(doc: &mut Document, results: &Results) {
 }
 
 /// Which build ran which records ([`crate::experiment::manifest::Session`]), and that times
-/// compare only within one build and machine.
+/// compare only within one build and machine. Records before the first session are a
+/// merge's parts' (named with their builds above) or, in a directory written before builds
+/// were recorded, of a build not recorded; sessions that added no record are left out; a
+/// list that contradicts the run log is said to be unusable rather than read.
 pub(crate) fn builds(m: &crate::experiment::manifest::Manifest, records: usize) -> String {
-    const CAVEAT: &str = "Times are of that build on that machine: compare them only with \
-                          times of the same build and machine.";
-    // Consecutive sessions of one build, as (build, first session's start, first record).
-    let mut spans: Vec<(&str, &str, usize)> = Vec::new();
+    const CAVEAT: &str = "Times are of the build that ran them on that machine: compare them \
+                          only with times of the same build and machine.";
+    const MIXED: &str = "Runs of different builds are mixed here: their times are not \
+                         comparable with each other.";
+    let merged = !m.merged_from.is_empty();
+    let parts_builds: Vec<&str> = (m.merged_from.iter())
+        .flat_map(|p| {
+            if p.builds.is_empty() {
+                vec!["not recorded"]
+            } else {
+                p.builds.iter().map(String::as_str).collect()
+            }
+        })
+        .collect();
+    fn known(b: &str) -> &str {
+        if b.is_empty() { "unknown" } else { b }
+    }
+    // (who ran them, start, first record): the records before the first session, then each
+    // session's.
+    let mut spans: Vec<(String, Option<&str>, usize)> = Vec::new();
+    let first = m.sessions.first().map_or(records, |s| s.runs_before);
+    if first > 0 {
+        let who = if merged {
+            "the merged parts (above)".to_string()
+        } else {
+            "a build not recorded (written before quadrecomb recorded its builds, \
+             2026-12-05)"
+                .to_string()
+        };
+        spans.push((who, None, 0));
+    }
+    let mut last = 0;
     for s in &m.sessions {
-        if spans.last().is_none_or(|l| l.0 != s.build) {
-            spans.push((&s.build, &s.started, s.runs_before));
+        if s.runs_before < last || s.runs_before > records {
+            return format!(
+                "Builds: the manifest's list of sessions does not fit the {records} records of \
+                 runs.jsonl (a session after {} records, after one after {last}), so which \
+                 build ran which records is unknown. {CAVEAT}",
+                s.runs_before
+            );
+        }
+        last = s.runs_before;
+        match spans.last_mut() {
+            // A session that added no record, or the same build resumed: one span.
+            Some(l) if l.2 == s.runs_before => {
+                *l = (known(&s.build).to_string(), Some(&s.started), l.2);
+            }
+            Some(l) if l.1.is_some() && l.0 == known(&s.build) => {}
+            _ => spans.push((known(&s.build).to_string(), Some(&s.started), s.runs_before)),
         }
     }
+    // A last session that added nothing.
+    if spans.len() > 1 && spans.last().is_some_and(|l| l.2 >= records) {
+        spans.pop();
+    }
+    let mut distinct: Vec<&str> = spans
+        .iter()
+        .filter(|s| s.1.is_some())
+        .map(|s| s.0.as_str())
+        .collect();
+    if first > 0 {
+        if merged {
+            distinct.extend(&parts_builds);
+        } else {
+            distinct.push("not recorded");
+        }
+    }
+    distinct.sort_unstable();
+    distinct.dedup();
+    let mixed = if distinct.len() > 1 { MIXED } else { "" };
     match spans.as_slice() {
-        [] if m.merged_from.is_empty() => format!(
-            "Build: not recorded (written before quadrecomb recorded its builds, 2026-12-05). \
-             {CAVEAT}"
-        ),
         [] => CAVEAT.to_string(),
-        [(build, started, _)] => {
-            let resumed = m.sessions.len() - 1;
-            let resumed = match resumed {
+        [(who, Some(started), 0)] => {
+            // The resumes that added runs.
+            let added = (m.sessions.iter().skip(1))
+                .filter(|s| s.runs_before < records)
+                .count();
+            let resumed = match added {
                 0 => String::new(),
                 1 => ", resumed once".to_string(),
                 n => format!(", resumed {n} times"),
             };
-            format!("Build: {build} (sweep started {started}{resumed}). {CAVEAT}")
+            format!("Build: {who} (sweep started {started}{resumed}). {CAVEAT}")
         }
+        [(_, None, _)] if merged => format!("{mixed} {CAVEAT}").trim_start().to_string(),
+        [(who, None, _)] => format!("Build: {who}. {CAVEAT}"),
         spans => {
-            let parts: Vec<String> = spans
-                .iter()
-                .enumerate()
-                .map(|(i, &(build, started, first))| {
+            const SHOWN: usize = 8;
+            let mut parts: Vec<String> = (spans.iter().enumerate().take(SHOWN))
+                .map(|(i, (who, started, first))| {
                     let end = spans.get(i + 1).map_or(records, |n| n.2);
-                    format!("records {}–{end} by {build} (started {started})", first + 1)
+                    let when = started.map_or(String::new(), |s| format!(" (started {s})"));
+                    format!("records {}–{end} by {who}{when}", first + 1)
                 })
                 .collect();
-            format!(
-                "Builds: {}. Runs of different builds are mixed here: their times are not \
-                 comparable with each other. {CAVEAT}",
-                parts.join("; ")
-            )
+            if spans.len() > SHOWN {
+                parts.push(format!("and {} more spans", spans.len() - SHOWN));
+            }
+            format!("Builds: {}. {mixed} {CAVEAT}", parts.join("; ")).replace("  ", " ")
         }
     }
 }

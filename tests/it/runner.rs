@@ -344,10 +344,41 @@ fn manifest_records_each_sweeps_build_and_the_report_says_which_ran_what() {
     assert!(text.contains(&want), "{want}\n{text}");
     assert!(text.contains("their times are not comparable"), "{text}");
 
+    // A later sweep that added no run (a resume of a finished directory) is no build of
+    // these records.
+    let other = "quadrecomb 0.0.9, git 000000000000";
+    let session = |build: &str, runs_before: usize| serde_json::json!({"build": build, "started": started, "runs_before": runs_before});
+    m["sessions"] = serde_json::json!([session(&build, 0), session(other, total)]);
+    std::fs::write(dir.join("out/manifest.json"), m.to_string()).unwrap();
+    let text = report(dir);
+    assert!(
+        text.contains(&format!("Build: {build} (sweep started {started}).")),
+        "{text}"
+    );
+    assert!(!text.contains("are mixed"), "{text}");
+
+    // A directory written before builds were recorded, then resumed: its first records are
+    // no build's that the manifest knows.
+    m["sessions"] = serde_json::json!([session(other, kept)]);
+    std::fs::write(dir.join("out/manifest.json"), m.to_string()).unwrap();
+    let text = report(dir);
+    let want = format!(
+        "Builds: records 1–{kept} by a build not recorded (written before quadrecomb \
+         recorded its builds, 2026-12-05); records {}–{total} by {other} (started {started}). \
+         Runs of different builds are mixed here",
+        kept + 1
+    );
+    assert!(text.contains(&want), "{want}\n{text}");
+
+    // A list that contradicts the run log is not read.
+    m["sessions"] = serde_json::json!([session(other, 0), session(&build, total + 5)]);
+    std::fs::write(dir.join("out/manifest.json"), m.to_string()).unwrap();
+    assert!(report(dir).contains("does not fit the"), "{}", report(dir));
+
     // A directory written before builds were recorded.
     m.as_object_mut().unwrap().remove("sessions");
     std::fs::write(dir.join("out/manifest.json"), m.to_string()).unwrap();
-    assert!(report(dir).contains("Build: not recorded"));
+    assert!(report(dir).contains("Build: a build not recorded"));
 }
 
 #[test]
