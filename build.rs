@@ -26,11 +26,20 @@ fn main() {
     }
     if let Some(dir) = git(&["rev-parse", "--git-dir"]) {
         let dir = Path::new(&dir);
-        for file in ["HEAD", "packed-refs"] {
-            println!("cargo:rerun-if-changed={}", dir.join(file).display());
-        }
+        // The branch's ref may be only in packed-refs until a commit writes it loose under
+        // refs/heads, which is watched as a directory.
+        let mut watched = vec![
+            dir.join("HEAD"),
+            dir.join("packed-refs"),
+            dir.join("refs").join("heads"),
+        ];
         if let Some(head) = git(&["symbolic-ref", "-q", "HEAD"]) {
-            println!("cargo:rerun-if-changed={}", dir.join(head).display());
+            watched.push(dir.join(head));
+        }
+        // A path that does not exist would make every build stale (a fresh clone has no
+        // packed-refs, say).
+        for path in watched.iter().filter(|p| p.exists()) {
+            println!("cargo:rerun-if-changed={}", path.display());
         }
     }
     let build = match git(&["rev-parse", "--short=12", "HEAD"]) {
